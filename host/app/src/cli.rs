@@ -1,0 +1,219 @@
+//! Command-line interface (clap derive): the host, the bus client, the demo, and the
+//! offline tools.
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand};
+use std::io::Read;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+use tsukami::bus::{default_endpoint, BusConfig};
+use tsukami::client::{BusClient, RequestError};
+use tsukami::config::HostConfig;
+use tsukami::server::RunningHost;
+use tsukami_msgs::keys::{self, ROLE_GRASP_PLANNER};
+
+/// Tsukami: grasp planning for humanoid robots with multi-fingered hands.
+#[derive(Parser, Debug)]
+#[command(name = "tsukami", version, about)]
+struct Cli {
+    #[command(flatten)]
+    bus: BusArgs,
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// How the client subcommands reach the bus.
+#[derive(Args, Debug)]
+struct BusArgs {
+    /// Key-expression namespace.
+    #[arg(long, global = true, default_value = keys::DEFAULT_NAMESPACE)]
+    namespace: String,
+    /// Endpoint of the host to connect to (loopback only without --zenoh-config).
+    #[arg(long, global = true)]
+    connect: Option<String>,
+    /// A zenoh json5 config file; replaces the built-in loopback-only config.
+    #[arg(long, global = true)]
+    zenoh_config: Option<PathBuf>,
+    /// How long to wait for a reply, milliseconds.
+    #[arg(long, global = true, default_value_t = 30_000)]
+    timeout_ms: u64,
+}
+
+impl BusArgs {
+    fn client_bus(&self) -> BusConfig {
+        let mut bus = BusConfig::connecting(self.connect.as_deref().unwrap_or(&default_endpoint()));
+        bus.zenoh_config = self.zenoh_config.clone();
+        bus
+    }
+
+    fn timeout(&self) -> Duration {
+        Duration::from_millis(self.timeout_ms)
+    }
+}
+
+/// A request payload: inline JSON, `--file F`, or `-` for standard input.
+#[derive(Args, Debug)]
+struct Payload {
+    /// The request as JSON text, or `-` to read it from standard input.
+    json: Option<String>,
+    /// Read the request from this file.
+    #[arg(long, conflicts_with = "json")]
+    file: Option<PathBuf>,
+}
+
+impl Payload {
+    fn bytes(&self) -> Result<Vec<u8>> {
+        match (&self.json, &self.file) {
+            (_, Some(file)) => std::fs::read(file).with_context(|| format!("reading {}", file.display())),
+            (Some(text), None) if text == "-" => {
+                let mut buf = Vec::new();
+                std::io::stdin().read_to_end(&mut buf).context("reading standard input")?;
+                Ok(buf)
+            }
+            (Some(text), None) => Ok(text.clone().into_bytes()),
+            (None, None) => Ok(b"{}".to_vec()),
+        }
+    }
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Serve the configured plugins on the bus until interrupted.
+    Run {
+        /// Host config file (TOML); without it, the built-in default.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Override the listen endpoint(s) of the config.
+        #[arg(long)]
+        listen: Vec<String>,
+    },
+    /// List the host's plugins, versions and roles.
+    Plugins,
+    /// SetRobot: send the robot model and grasp-type config to the planner.
+    SetRobot(Payload),
+    /// SetObject: send the object to grasp.
+    SetObject(Payload),
+    /// SetEnv: add or replace environment obstacles.
+    SetEnv(Payload),
+    /// RemoveEnv: remove environment obstacles.
+    RemoveEnv(Payload),
+    /// Plan: plan a grasp.
+    Plan(Payload),
+    /// Stop: cancel the planner's running call.
+    Stop,
+    /// Write the JSON Schema of every bus payload.
+    Schema {
+        /// Output folder.
+        #[arg(long, default_value = "docs/schema")]
+        out: PathBuf,
+    },
+    /// Run the main job: start a private host with its plugins and show it working.
+    Demo(tsukami::demo::DemoArgs),
+}
+
+/// Runs the CLI and maps errors to a message and exit status 1.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn,tsukami=info")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("tsukami: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<ExitCode> {
+    let planner = |command: &str, payload: &Payload| -> Result<ExitCode> {
+        send(&cli.bus, ROLE_GRASP_PLANNER, command, &payload.bytes()?)
+    };
+    match &cli.command {
+        Command::Run { config, listen } => serve(config.as_deref(), listen, &cli.bus),
+        Command::Plugins => {
+            let client = BusClient::connect(&cli.bus.client_bus(), &cli.bus.namespace)?;
+            let key = client.keys().host_plugins();
+            print_reply(client.request_key(&key, b"", cli.bus.timeout()))
+        }
+        Command::SetRobot(p) => planner(keys::planner::SET_ROBOT, p),
+        Command::SetObject(p) => planner(keys::planner::SET_OBJECT, p),
+        Command::SetEnv(p) => planner(keys::planner::SET_ENV, p),
+        Command::RemoveEnv(p) => planner(keys::planner::REMOVE_ENV, p),
+        Command::Plan(p) => planner(keys::planner::PLAN, p),
+        Command::Stop => send(&cli.bus, ROLE_GRASP_PLANNER, keys::STOP, b""),
+        Command::Schema { out } => write_schema(out),
+        Command::Demo(args) => tsukami::demo::run(args),
+    }
+}
+
+fn serve(config: Option<&std::path::Path>, listen: &[String], bus: &BusArgs) -> Result<ExitCode> {
+    let mut config = match config {
+        Some(path) => HostConfig::from_file(path)?,
+        None => HostConfig::default_config()?,
+    };
+    config.namespace = bus.namespace.clone();
+    if !listen.is_empty() {
+        config.bus.listen = listen.to_vec();
+    }
+    if bus.zenoh_config.is_some() {
+        config.bus.zenoh_config = bus.zenoh_config.clone();
+    }
+    let host = RunningHost::start(&config)?;
+    eprintln!(
+        "tsukami: serving {} plugin(s) under `{}` on {:?}; Ctrl-C to stop",
+        host.plugins().plugins.len(),
+        config.namespace,
+        config.bus.listen
+    );
+    for plugin in &host.plugins().plugins {
+        eprintln!("  {:<20} {} {}", plugin.roles.join(","), plugin.name, plugin.version);
+    }
+    // Serve until the process is interrupted: the workers and zenoh run on their own
+    // threads; this one only waits.
+    loop {
+        std::thread::park();
+    }
+}
+
+fn send(bus: &BusArgs, role: &str, command: &str, payload: &[u8]) -> Result<ExitCode> {
+    let client = BusClient::connect(&bus.client_bus(), &bus.namespace)?;
+    print_reply(client.command(role, command, payload, bus.timeout()))
+}
+
+fn print_reply(reply: Result<Vec<u8>, RequestError>) -> Result<ExitCode> {
+    match reply {
+        Ok(bytes) => {
+            println!("{}", pretty(&bytes));
+            Ok(ExitCode::SUCCESS)
+        }
+        Err(RequestError::Reply(error)) => {
+            println!("{}", serde_json::to_string_pretty(&error)?);
+            eprintln!("tsukami: {error}");
+            Ok(ExitCode::FAILURE)
+        }
+        Err(other) => Err(other.into()),
+    }
+}
+
+fn pretty(bytes: &[u8]) -> String {
+    serde_json::from_slice::<serde_json::Value>(bytes)
+        .and_then(|v| serde_json::to_string_pretty(&v))
+        .unwrap_or_else(|_| String::from_utf8_lossy(bytes).into_owned())
+}
+
+fn write_schema(out: &std::path::Path) -> Result<ExitCode> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    for schema in tsukami_msgs::schema::all() {
+        let path = out.join(format!("{}.schema.json", schema.name));
+        std::fs::write(&path, schema.json).with_context(|| format!("writing {}", path.display()))?;
+    }
+    eprintln!("tsukami: wrote {} schemas to {}", tsukami_msgs::schema::all().len(), out.display());
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,206 @@
+//! The host config (TOML): namespace, bus, limits, and which plugin fills which role.
+//!
+//! ```toml
+//! namespace = "tsukami"
+//!
+//! [bus]
+//! listen = ["tcp/127.0.0.1:17447"]
+//!
+//! [[plugin]]
+//! role = "grasp-planner"
+//! library = "tsukami_grasp_planner"   # platform prefix/extension added; or `path = "…/libx.so"`
+//! [plugin.config]                     # handed to the plugin as TOML text
+//! models_dir = "../models"
+//! ```
+//!
+//! Relative paths are relative to the config file. A plugin given by `library`
+//! name alone (no directory) is looked for beside the `tsukami` executable and in
+//! its `deps/` folder, which is where cargo puts the workspace's plugin libraries.
+//! Swapping in a third-party planner is a config change: name its library for the
+//! `grasp-planner` role.
+
+use crate::bus::{default_endpoint, BusConfig};
+use anyhow::{bail, Context, Result};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use tsukami_msgs::keys::DEFAULT_NAMESPACE;
+use tsukami_plugin_api::loader::library_file_name;
+
+/// The whole host config.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct HostConfig {
+    /// Key-expression namespace, so several robots can share a bus.
+    #[serde(default = "default_namespace")]
+    pub namespace: String,
+    /// How to join the bus.
+    #[serde(default = "default_bus")]
+    pub bus: BusConfig,
+    /// Request limits.
+    #[serde(default)]
+    pub limits: Limits,
+    /// The plugins, one entry per role.
+    #[serde(default, rename = "plugin")]
+    pub plugins: Vec<PluginEntryConfig>,
+    /// The folder relative paths resolve against (the config file's folder).
+    #[serde(skip)]
+    pub base_dir: PathBuf,
+}
+
+/// Request limits.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Limits {
+    /// Largest request payload the host passes to a plugin, bytes.
+    #[serde(default = "default_max_payload")]
+    pub max_payload_bytes: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits { max_payload_bytes: default_max_payload() }
+    }
+}
+
+/// One plugin and the role it fills.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PluginEntryConfig {
+    /// The role: `grasp-planner`, `trajectory-planner`, `result-viewer`, or a
+    /// third-party role (its bus prefix is then the role name).
+    pub role: String,
+    /// Library name without platform prefix and extension (`tsukami_grasp_planner`).
+    #[serde(default)]
+    pub library: Option<String>,
+    /// Exact path of the library file.
+    #[serde(default)]
+    pub path: Option<PathBuf>,
+    /// The plugin's own config, handed to it as TOML text.
+    #[serde(default)]
+    pub config: Option<toml::Table>,
+}
+
+fn default_namespace() -> String {
+    DEFAULT_NAMESPACE.to_owned()
+}
+
+fn default_bus() -> BusConfig {
+    BusConfig::listening(&default_endpoint())
+}
+
+fn default_max_payload() -> usize {
+    16 * 1024 * 1024
+}
+
+/// The config used when `tsukami run` gets no `--config`: the default port and the
+/// workspace's own plugins, found beside the executable.
+pub const DEFAULT_CONFIG: &str = r#"
+namespace = "tsukami"
+
+[bus]
+listen = ["tcp/127.0.0.1:17447"]
+
+[[plugin]]
+role = "grasp-planner"
+library = "tsukami_grasp_planner"
+"#;
+
+impl HostConfig {
+    /// Parses config text; relative paths will resolve against `base_dir`.
+    pub fn parse(text: &str, base_dir: &Path, origin: &str) -> Result<HostConfig> {
+        let mut config: HostConfig = toml::from_str(text).with_context(|| format!("parsing host config {origin}"))?;
+        config.base_dir = base_dir.to_owned();
+        for entry in &config.plugins {
+            if entry.library.is_some() == entry.path.is_some() {
+                bail!("host config {origin}: plugin for role `{}` needs exactly one of `library` or `path`", entry.role);
+            }
+        }
+        Ok(config)
+    }
+
+    /// Reads a config file.
+    pub fn from_file(path: &Path) -> Result<HostConfig> {
+        let text = std::fs::read_to_string(path).with_context(|| format!("reading host config {}", path.display()))?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        HostConfig::parse(&text, base, &path.display().to_string())
+    }
+
+    /// The embedded default config, with plugins resolved beside the executable.
+    pub fn default_config() -> Result<HostConfig> {
+        HostConfig::parse(DEFAULT_CONFIG, Path::new("."), "(built-in default)")
+    }
+
+    /// A config with no plugins (tests add their own).
+    pub fn empty(namespace: &str, bus: BusConfig) -> HostConfig {
+        HostConfig {
+            namespace: namespace.to_owned(),
+            bus,
+            limits: Limits::default(),
+            plugins: vec![],
+            base_dir: PathBuf::from("."),
+        }
+    }
+
+    /// Resolves the plugin file of an entry.
+    pub fn plugin_file(&self, entry: &PluginEntryConfig) -> Result<PathBuf> {
+        if let Some(path) = &entry.path {
+            return Ok(self.base_dir.join(path));
+        }
+        let name = entry.library.as_deref().unwrap_or_default();
+        let given = Path::new(name);
+        let file_name = library_file_name(given.file_name().and_then(|n| n.to_str()).unwrap_or(name));
+        if given.parent().is_some_and(|p| !p.as_os_str().is_empty()) {
+            return Ok(self.base_dir.join(given.with_file_name(file_name)));
+        }
+        let candidates = plugin_search_dirs().into_iter().map(|dir| dir.join(&file_name));
+        let tried: Vec<PathBuf> = candidates.collect();
+        tried
+            .iter()
+            .find(|p| p.is_file())
+            .cloned()
+            .with_context(|| format!("plugin library `{file_name}` for role `{}` not found; looked in {tried:?} (build it with `cargo build --workspace`)", entry.role))
+    }
+}
+
+/// Where plugins named without a folder are looked for: the executable's folder,
+/// its `deps/` and (for test binaries, which live in `deps/`) the folder above.
+pub fn plugin_search_dirs() -> Vec<PathBuf> {
+    let Ok(exe) = std::env::current_exe() else { return vec![] };
+    let Some(dir) = exe.parent() else { return vec![] };
+    let mut dirs = vec![dir.to_owned(), dir.join("deps")];
+    if dir.ends_with("deps") {
+        if let Some(up) = dir.parent() {
+            dirs.push(up.to_owned());
+        }
+    }
+    dirs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_config_parses() {
+        let config = HostConfig::default_config().unwrap();
+        assert_eq!(config.namespace, "tsukami");
+        assert_eq!(config.bus.listen, vec!["tcp/127.0.0.1:17447".to_owned()]);
+        assert_eq!(config.plugins[0].role, "grasp-planner");
+    }
+
+    #[test]
+    fn unknown_fields_and_ambiguous_plugins_are_refused() {
+        assert!(HostConfig::parse("namespaec = \"x\"", Path::new("."), "t").is_err());
+        let both = "[[plugin]]\nrole = \"a\"\nlibrary = \"x\"\npath = \"y\"\n";
+        let err = HostConfig::parse(both, Path::new("."), "t").unwrap_err();
+        assert!(format!("{err:#}").contains("exactly one"), "{err:#}");
+    }
+
+    #[test]
+    fn relative_paths_resolve_against_the_config_folder() {
+        let text = "[[plugin]]\nrole = \"a\"\nlibrary = \"plugins/my_planner\"\n";
+        let config = HostConfig::parse(text, Path::new("/etc/tsukami"), "t").unwrap();
+        let file = config.plugin_file(&config.plugins[0]).unwrap();
+        assert_eq!(file, Path::new("/etc/tsukami/plugins").join(library_file_name("my_planner")));
+    }
+}

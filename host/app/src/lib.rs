@@ -1,0 +1,21 @@
+//! The Tsukami host and its command-line client, as a library.
+//!
+//! The `tsukami` binary is a thin layer over this crate; tests and embedders start a
+//! host in-process with [`server::RunningHost::start`] and talk to it with
+//! [`client::BusClient`], over a real zenoh bus on loopback.
+//!
+//! - [`config`]: the host config (TOML): namespace, bus, plugins and their roles.
+//! - [`bus`]: the zenoh configuration — loopback only, no multicast, unless the user
+//!   hands in a zenoh config file of their own.
+//! - [`server`]: loads the plugins, owns the one zenoh session, routes each role's
+//!   queries to its plugin on a worker thread, answers `stop` and `host/plugins`.
+//! - [`host_handle`]: what a plugin reaches the bus through.
+//! - [`demo`]: `tsukami demo`, the main job.
+//! - [`client`]: a small blocking client for the bus (CLI, demo, tests, benches).
+
+pub mod bus;
+pub mod client;
+pub mod config;
+pub mod demo;
+pub mod host_handle;
+pub mod server;

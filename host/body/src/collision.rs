@@ -1,0 +1,472 @@
+//! Collision and distance between robot links, objects and obstacles
+//! (parry3d), with witness points and surface normals — what PQP gave the
+//! paper's planner.
+//!
+//! * [`CollisionObject`]: a rigid set of shapes with a world pose — a grasped
+//!   object, a table, a fridge. Meshes get parry's BVH, so a 100k-triangle
+//!   object stays fast.
+//! * [`RobotCollision`]: the collision shapes of every link of a
+//!   [`RobotModel`] and the allowed (never checked) link pairs. Queries read
+//!   link poses from an [`FkState`], so the caller runs forward kinematics
+//!   once per configuration and then asks as many questions as it needs.
+//!
+//! # Meshes are surfaces
+//! A parry `TriMesh` is a surface: a link entirely inside a mesh is at a
+//! positive distance from it and does not intersect it. Meshes that are
+//! closed ([`TriangleMesh::is_closed`]) are therefore built with parry's
+//! oriented pseudo-normals and treated as solids: when a query finds a link
+//! separated from such a mesh, it also tests whether the link lies inside it,
+//! and reports a collision (a negative distance, see [`Proximity`]) if so.
+//! Open meshes stay surfaces; callers that need solids should refuse them
+//! ([`CollisionObject::is_solid`]).
+
+use nalgebra::{Isometry3, Point3, Unit, UnitQuaternion, Vector3};
+use parry3d_f64::math::Pose;
+use parry3d_f64::query::{self, ClosestPoints};
+use parry3d_f64::shape::{SharedShape, TriMesh, TriMeshFlags};
+
+use crate::convert::{from_pose, to_point, to_pose, to_vec, to_vector};
+use crate::error::{BodyError, Result};
+use crate::kinematics::FkState;
+use crate::mesh::TriangleMesh;
+use crate::model::{Geometry, LinkId, RobotModel};
+
+/// One shape of a link or object, placed in its owner's frame.
+#[derive(Clone)]
+pub struct Part {
+    /// Pose of the shape in the owner's frame.
+    pub origin: Pose,
+    /// The parry shape.
+    pub shape: SharedShape,
+    /// True for a closed mesh treated as a solid (inside tests enabled).
+    pub solid_mesh: bool,
+}
+
+impl std::fmt::Debug for Part {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Part")
+            .field("origin", &from_pose(&self.origin))
+            .field("shape", &self.shape.shape_type())
+            .field("solid_mesh", &self.solid_mesh)
+            .finish()
+    }
+}
+
+impl Part {
+    /// Builds the parry shape of a geometry placed at `origin`.
+    pub fn from_geometry(origin: &Isometry3<f64>, geometry: &Geometry) -> Result<Self> {
+        let (shape, extra, solid_mesh) = match geometry {
+            Geometry::Box { size } => (
+                SharedShape::cuboid(size.x / 2.0, size.y / 2.0, size.z / 2.0),
+                Isometry3::identity(),
+                false,
+            ),
+            // parry's cylinder is along y, URDF's along z.
+            Geometry::Cylinder { radius, length } => (
+                SharedShape::cylinder(length / 2.0, *radius),
+                Isometry3::from_parts(
+                    nalgebra::Translation3::identity(),
+                    UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2),
+                ),
+                false,
+            ),
+            Geometry::Capsule { radius, length } => (
+                SharedShape::capsule_z(length / 2.0, *radius),
+                Isometry3::identity(),
+                false,
+            ),
+            Geometry::Sphere { radius } => (SharedShape::ball(*radius), Isometry3::identity(), false),
+            Geometry::Mesh { path, mesh, .. } => {
+                let (trimesh, solid) = build_trimesh(mesh).map_err(|message| BodyError::Mesh {
+                    file: path.clone(),
+                    message,
+                })?;
+                (SharedShape::new(trimesh), Isometry3::identity(), solid)
+            }
+        };
+        Ok(Self {
+            origin: to_pose(&(origin * extra)),
+            shape,
+            solid_mesh,
+        })
+    }
+}
+
+/// Builds a parry mesh (with its BVH); closed meshes get oriented
+/// pseudo-normals so inside tests work. Returns the mesh and whether it is a
+/// solid.
+pub fn build_trimesh(mesh: &TriangleMesh) -> std::result::Result<(TriMesh, bool), String> {
+    mesh.validate()?;
+    let closed = mesh.is_closed();
+    let flags = if closed {
+        TriMeshFlags::ORIENTED | TriMeshFlags::MERGE_DUPLICATE_VERTICES
+    } else {
+        TriMeshFlags::empty()
+    };
+    let vertices = mesh.vertices.iter().map(to_vec).collect();
+    TriMesh::with_flags(vertices, mesh.indices.clone(), flags)
+        .map(|m| (m, closed))
+        .map_err(|e| format!("cannot build the collision mesh: {e}"))
+}
+
+/// A rigid collision body with a world pose: an object or an obstacle.
+#[derive(Debug, Clone)]
+pub struct CollisionObject {
+    /// Name (for messages and reports).
+    pub name: String,
+    pose: Isometry3<f64>,
+    parry_pose: Pose,
+    parts: Vec<Part>,
+}
+
+impl CollisionObject {
+    /// An object made of shapes placed in its frame, at `pose` in the world.
+    pub fn new(name: impl Into<String>, pose: Isometry3<f64>, parts: Vec<Part>) -> Self {
+        Self {
+            name: name.into(),
+            parry_pose: to_pose(&pose),
+            pose,
+            parts,
+        }
+    }
+
+    /// An object whose single shape is a triangle mesh (in the object frame).
+    pub fn from_mesh(
+        name: impl Into<String>,
+        pose: Isometry3<f64>,
+        mesh: &TriangleMesh,
+    ) -> std::result::Result<Self, String> {
+        let (trimesh, solid) = build_trimesh(mesh)?;
+        Ok(Self::new(
+            name,
+            pose,
+            vec![Part {
+                origin: Pose::IDENTITY,
+                shape: SharedShape::new(trimesh),
+                solid_mesh: solid,
+            }],
+        ))
+    }
+
+    /// The world pose.
+    pub fn pose(&self) -> &Isometry3<f64> {
+        &self.pose
+    }
+
+    /// Moves the object.
+    pub fn set_pose(&mut self, pose: Isometry3<f64>) {
+        self.pose = pose;
+        self.parry_pose = to_pose(&pose);
+    }
+
+    /// The shapes.
+    pub fn parts(&self) -> &[Part] {
+        &self.parts
+    }
+
+    /// True when every part is a solid (a primitive or a closed mesh).
+    pub fn is_solid(&self) -> bool {
+        self.parts
+            .iter()
+            .all(|p| p.solid_mesh || p.shape.as_trimesh().is_none())
+    }
+}
+
+/// Closest points between a link and an object.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Proximity {
+    /// Distance (m); negative when they overlap (the penetration depth), or
+    /// when the link lies inside a closed mesh (then minus the distance from
+    /// the link to the mesh surface, a lower bound of the depth).
+    pub distance: f64,
+    /// Witness point on the link's surface (world frame).
+    pub point_on_link: Point3<f64>,
+    /// Witness point on the object's surface (world frame).
+    pub point_on_object: Point3<f64>,
+    /// Unit outward normal of the object's surface at `point_on_object`
+    /// (world frame): the direction in which the link must move to
+    /// separate. When separated it points from the object toward the link.
+    pub normal: Unit<Vector3<f64>>,
+    /// Which part of the link (index into its collision elements).
+    pub link_part: usize,
+    /// Which part of the object.
+    pub object_part: usize,
+}
+
+/// Proximity between two placed shapes, or `None` if farther than
+/// `max_distance`.
+fn pair_proximity(
+    pose1: &Pose,
+    p1: &Part,
+    pose2: &Pose,
+    p2: &Part,
+    max_distance: f64,
+) -> Option<(f64, Point3<f64>, Point3<f64>, Unit<Vector3<f64>>)> {
+    let w1 = *pose1 * p1.origin;
+    let w2 = *pose2 * p2.origin;
+    let cp = query::closest_points(&w1, &*p1.shape, &w2, &*p2.shape, max_distance).ok()?;
+    match cp {
+        ClosestPoints::WithinMargin(a, b) => {
+            let d = (a - b).length();
+            if d > 1e-12 {
+                let n = Unit::new_normalize(to_vector(a - b));
+                if p2.solid_mesh && p2.shape.contains_point(&w2, a) {
+                    // The link is inside the closed mesh.
+                    return Some((-d, to_point(a), to_point(b), -n));
+                }
+                return Some((d, to_point(a), to_point(b), n));
+            }
+            penetration(&w1, p1, &w2, p2)
+        }
+        ClosestPoints::Intersecting => penetration(&w1, p1, &w2, p2),
+        ClosestPoints::Disjoint => None,
+    }
+}
+
+fn penetration(
+    w1: &Pose,
+    p1: &Part,
+    w2: &Pose,
+    p2: &Part,
+) -> Option<(f64, Point3<f64>, Point3<f64>, Unit<Vector3<f64>>)> {
+    match query::contact(w1, &*p1.shape, w2, &*p2.shape, 0.0) {
+        Ok(Some(c)) => {
+            let n = Unit::try_new(to_vector(c.normal2), 1e-12).unwrap_or(Vector3::z_axis());
+            Some((c.dist.min(0.0), to_point(c.point1), to_point(c.point2), n))
+        }
+        // Touching within round-off but no contact manifold: report contact
+        // at distance zero along the world z axis.
+        _ => {
+            let a = to_point(w1.translation);
+            Some((0.0, a, a, Vector3::z_axis()))
+        }
+    }
+}
+
+/// Broad phase: do the world AABBs of two placed parts overlap (with a margin)?
+fn aabbs_overlap(pose1: &Pose, p1: &Part, pose2: &Pose, p2: &Part, margin: f64) -> bool {
+    let a = p1.shape.compute_aabb(&(*pose1 * p1.origin));
+    let b = p2.shape.compute_aabb(&(*pose2 * p2.origin));
+    a.mins.x <= b.maxs.x + margin
+        && b.mins.x <= a.maxs.x + margin
+        && a.mins.y <= b.maxs.y + margin
+        && b.mins.y <= a.maxs.y + margin
+        && a.mins.z <= b.maxs.z + margin
+        && b.mins.z <= a.maxs.z + margin
+}
+
+/// Do two placed parts collide, i.e. come closer than `margin` (or overlap,
+/// or one lies inside the other's closed mesh)?
+fn pair_collides(pose1: &Pose, p1: &Part, pose2: &Pose, p2: &Part, margin: f64) -> bool {
+    if !aabbs_overlap(pose1, p1, pose2, p2, margin) {
+        return false;
+    }
+    let w1 = *pose1 * p1.origin;
+    let w2 = *pose2 * p2.origin;
+    let hit = if margin > 0.0 {
+        !matches!(
+            query::closest_points(&w1, &*p1.shape, &w2, &*p2.shape, margin),
+            Ok(ClosestPoints::Disjoint)
+        )
+    } else {
+        query::intersection_test(&w1, &*p1.shape, &w2, &*p2.shape)
+            .map(|r| r.intersecting)
+            .unwrap_or(false)
+    };
+    if hit {
+        return true;
+    }
+    // A shape wholly inside a closed mesh does not touch its surface.
+    let inside = |wa: &Pose, pa: &Part, wb: &Pose, pb: &Part| {
+        pb.solid_mesh && pb.shape.contains_point(wb, pa.shape.compute_aabb(wa).center())
+    };
+    inside(&w1, p1, &w2, p2) || inside(&w2, p2, &w1, p1)
+}
+
+/// A colliding pair found by [`RobotCollision::first_collision`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Hit {
+    /// The link.
+    pub link: LinkId,
+    /// Index of the object in the slice given to the query.
+    pub object: usize,
+}
+
+/// The collision shapes of a robot's links and the link pairs never checked
+/// for self-collision.
+#[derive(Debug, Clone)]
+pub struct RobotCollision {
+    parts: Vec<Vec<Part>>,
+    /// Row-major `n × n` table of allowed pairs.
+    allowed: Vec<bool>,
+    n: usize,
+    /// Links with geometry, for self-collision loops.
+    with_geometry: Vec<LinkId>,
+}
+
+impl RobotCollision {
+    /// Builds the link shapes from the model's `<collision>` elements. By
+    /// default a link may touch its nearest ancestor that has geometry (its
+    /// "adjacent" link) and any link rigidly attached to it (only fixed joints
+    /// between them).
+    pub fn new(model: &RobotModel) -> Result<Self> {
+        let n = model.links.len();
+        let mut parts = Vec::with_capacity(n);
+        for link in &model.links {
+            let p = link
+                .collisions
+                .iter()
+                .map(|e| Part::from_geometry(&e.origin, &e.geometry))
+                .collect::<Result<Vec<_>>>()?;
+            parts.push(p);
+        }
+        let with_geometry: Vec<LinkId> = (0..n).filter(|&l| !parts[l].is_empty()).collect();
+        let mut me = Self {
+            parts,
+            allowed: vec![false; n * n],
+            n,
+            with_geometry,
+        };
+        for l in 0..n {
+            me.allow(l, l);
+            if me.parts[l].is_empty() {
+                continue;
+            }
+            // Nearest ancestor with geometry, and rigidly attached ones.
+            let mut rigid = true;
+            let mut found = false;
+            let mut a = l;
+            while let Some(j) = model.links[a].parent_joint {
+                rigid &= !model.joints[j].is_movable();
+                a = model.joints[j].parent;
+                let has = !me.parts[a].is_empty();
+                if rigid || (has && !found) {
+                    me.allow(l, a);
+                }
+                found |= has;
+                if found && !rigid {
+                    break;
+                }
+            }
+        }
+        Ok(me)
+    }
+
+    /// Never check the pair `(a, b)` for self-collision.
+    pub fn allow(&mut self, a: LinkId, b: LinkId) {
+        self.allowed[a * self.n + b] = true;
+        self.allowed[b * self.n + a] = true;
+    }
+
+    /// Check the pair `(a, b)` again.
+    pub fn disallow(&mut self, a: LinkId, b: LinkId) {
+        self.allowed[a * self.n + b] = false;
+        self.allowed[b * self.n + a] = false;
+    }
+
+    /// Is the pair allowed to touch?
+    pub fn is_allowed(&self, a: LinkId, b: LinkId) -> bool {
+        self.allowed[a * self.n + b]
+    }
+
+    /// The collision shapes of a link.
+    pub fn link_parts(&self, link: LinkId) -> &[Part] {
+        &self.parts[link]
+    }
+
+    /// Distance, witness points and normal between `link` and `object` for
+    /// the configuration in `fk`; `None` when the link has no geometry or
+    /// they are farther apart than `max_distance`. With several shapes on
+    /// either side, the closest pair wins.
+    pub fn link_object_proximity(
+        &self,
+        fk: &FkState,
+        link: LinkId,
+        object: &CollisionObject,
+        max_distance: f64,
+    ) -> Option<Proximity> {
+        let link_pose = to_pose(fk.pose(link));
+        let mut best: Option<Proximity> = None;
+        for (i, lp) in self.parts[link].iter().enumerate() {
+            for (k, op) in object.parts.iter().enumerate() {
+                let limit = best.map_or(max_distance, |b| b.distance.min(max_distance));
+                if let Some((d, a, b, n)) =
+                    pair_proximity(&link_pose, lp, &object.parry_pose, op, limit.max(0.0))
+                {
+                    if best.is_none_or(|bb| d < bb.distance) {
+                        best = Some(Proximity {
+                            distance: d,
+                            point_on_link: a,
+                            point_on_object: b,
+                            normal: n,
+                            link_part: i,
+                            object_part: k,
+                        });
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// The first of `links` that comes closer than `margin` to (or overlaps,
+    /// or lies inside) one of `objects`; `None` when all are clear.
+    pub fn first_collision(
+        &self,
+        fk: &FkState,
+        links: &[LinkId],
+        objects: &[&CollisionObject],
+        margin: f64,
+    ) -> Option<Hit> {
+        for &link in links {
+            let link_pose = to_pose(fk.pose(link));
+            for (o, object) in objects.iter().enumerate() {
+                for lp in &self.parts[link] {
+                    for op in &object.parts {
+                        if pair_collides(&link_pose, lp, &object.parry_pose, op, margin) {
+                            return Some(Hit { link, object: o });
+                        }
+                    }
+                }
+            }
+        }
+        None
+    }
+
+    /// The first pair of links, not allowed to touch, that come closer than
+    /// `margin`; `None` when the robot is free of self-collision.
+    pub fn first_self_collision(&self, fk: &FkState, margin: f64) -> Option<(LinkId, LinkId)> {
+        self.self_collision_pairs(fk, margin, true).into_iter().next()
+    }
+
+    /// Every pair of links, not allowed to touch, that come closer than
+    /// `margin`.
+    pub fn self_collisions(&self, fk: &FkState, margin: f64) -> Vec<(LinkId, LinkId)> {
+        self.self_collision_pairs(fk, margin, false)
+    }
+
+    fn self_collision_pairs(&self, fk: &FkState, margin: f64, first: bool) -> Vec<(LinkId, LinkId)> {
+        let mut out = Vec::new();
+        for (ia, &a) in self.with_geometry.iter().enumerate() {
+            let pa = to_pose(fk.pose(a));
+            for &b in &self.with_geometry[ia + 1..] {
+                if self.is_allowed(a, b) {
+                    continue;
+                }
+                let pb = to_pose(fk.pose(b));
+                let hit = self.parts[a].iter().any(|x| {
+                    self.parts[b]
+                        .iter()
+                        .any(|y| pair_collides(&pa, x, &pb, y, margin))
+                });
+                if hit {
+                    out.push((a, b));
+                    if first {
+                        return out;
+                    }
+                }
+            }
+        }
+        out
+    }
+}

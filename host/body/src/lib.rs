@@ -1,0 +1,41 @@
+//! # tsukami-body
+//!
+//! Robot and object models for Tsukami (Choreonoid's "Body" library in the
+//! original grasp plugin): URDF loading, forward kinematics and Jacobians,
+//! inverse kinematics over a chosen joint list, and collision / distance
+//! queries with witness points and normals (parry3d).
+//!
+//! The public API speaks nalgebra; parry's glam types stay inside
+//! [`convert`] and [`collision`]. No I/O happens here beyond reading model,
+//! mesh, object and scene files.
+//!
+//! ```no_run
+//! use tsukami_body::{urdf::load_urdf, kinematics::FkState, collision::RobotCollision};
+//! let robot = load_urdf("models/robots/tsukami_humanoid/tsukami_humanoid.urdf".as_ref())?;
+//! let mut fk = FkState::new(&robot);
+//! robot.forward_kinematics(&robot.rest_positions(), &mut fk);
+//! let collision = RobotCollision::new(&robot)?;
+//! assert!(collision.first_self_collision(&fk, 0.0).is_none());
+//! # Ok::<(), tsukami_body::BodyError>(())
+//! ```
+//!
+//! Modules, lowest first: [`mesh`] (triangle meshes), [`model`] and [`urdf`]
+//! (the kinematic tree), [`kinematics`] (FK, Jacobians), [`ik`],
+//! [`collision`], [`shape_spec`], [`object`] and [`scene`] (TOML files), and
+//! [`report`] (what the `tsukami model` commands print).
+
+pub mod collision;
+pub mod convert;
+pub mod error;
+pub mod ik;
+pub mod kinematics;
+pub mod mesh;
+pub mod model;
+pub mod object;
+pub mod report;
+pub mod scene;
+pub mod shape_spec;
+pub mod urdf;
+
+pub use error::{BodyError, Result};
+pub use model::{JointId, LinkId, RobotModel};

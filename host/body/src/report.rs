@@ -1,0 +1,337 @@
+//! The functions behind `tsukami model inspect | fk | ik`: they take parsed
+//! arguments and return serde structs whose JSON is the CLI's contract
+//! (issue #3). Field names here must not change; fields may be added.
+//!
+//! * [`inspect`] → `{"links": [{"name", "mass"}], "joints": [{"name", "type",
+//!   "parent", "child", "lower", "upper", "effort", "velocity", "mimic"}]}`
+//! * [`fk`] / [`fk_batch`] → `{"links": {NAME: {"position": [x,y,z],
+//!   "quaternion": [x,y,z,w]}}}` in the model's root frame
+//! * [`ik`] / [`ik_batch`] → `{"ok", "joint_positions", "position_error",
+//!   "orientation_error", "iterations"}`
+//!
+//! No I/O here beyond reading the model; the CLI prints the JSON.
+
+use std::collections::BTreeMap;
+
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{BodyError, Result};
+use crate::ik::{IkOptions, IkSolver};
+use crate::kinematics::{FkState, JointSelection};
+use crate::model::{JointKind, RobotModel};
+
+/// A link in [`InspectReport`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LinkInfo {
+    /// Link name.
+    pub name: String,
+    /// Mass (kg).
+    pub mass: f64,
+}
+
+/// A mimic coupling in [`JointInfo`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MimicInfo {
+    /// Master joint.
+    pub joint: String,
+    /// Multiplier.
+    pub multiplier: f64,
+    /// Offset.
+    pub offset: f64,
+}
+
+/// A joint in [`InspectReport`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct JointInfo {
+    /// Joint name.
+    pub name: String,
+    /// `revolute`, `continuous`, `prismatic` or `fixed`.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// Parent link.
+    pub parent: String,
+    /// Child link.
+    pub child: String,
+    /// Lower limit (`null` for continuous and fixed joints).
+    pub lower: Option<f64>,
+    /// Upper limit (`null` for continuous and fixed joints).
+    pub upper: Option<f64>,
+    /// Effort limit (N·m or N).
+    pub effort: f64,
+    /// Velocity limit (rad/s or m/s).
+    pub velocity: f64,
+    /// Mimic coupling or `null`.
+    pub mimic: Option<MimicInfo>,
+}
+
+/// Output of `tsukami model inspect`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct InspectReport {
+    /// Robot name.
+    pub robot: String,
+    /// Root link.
+    pub root: String,
+    /// Total mass (kg).
+    pub total_mass: f64,
+    /// Links, root first.
+    pub links: Vec<LinkInfo>,
+    /// Joints, in the order of their child links.
+    pub joints: Vec<JointInfo>,
+}
+
+/// Describes a loaded model.
+pub fn inspect(model: &RobotModel) -> InspectReport {
+    let limit = |kind: JointKind, v: f64| match kind {
+        JointKind::Revolute | JointKind::Prismatic => Some(v),
+        _ => None,
+    };
+    InspectReport {
+        robot: model.name.clone(),
+        root: model.links[0].name.clone(),
+        total_mass: model.total_mass(),
+        links: model
+            .links
+            .iter()
+            .map(|l| LinkInfo {
+                name: l.name.clone(),
+                mass: l.inertial.mass,
+            })
+            .collect(),
+        joints: model
+            .joints
+            .iter()
+            .map(|j| JointInfo {
+                name: j.name.clone(),
+                kind: j.kind.as_str().to_string(),
+                parent: model.links[j.parent].name.clone(),
+                child: model.links[j.child].name.clone(),
+                lower: limit(j.kind, j.limits.lower),
+                upper: limit(j.kind, j.limits.upper),
+                effort: j.limits.effort,
+                velocity: j.limits.velocity,
+                mimic: j.mimic.as_ref().map(|m| MimicInfo {
+                    joint: m.joint_name.clone(),
+                    multiplier: m.multiplier,
+                    offset: m.offset,
+                }),
+            })
+            .collect(),
+    }
+}
+
+/// A link pose in [`FkReport`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LinkPose {
+    /// Position `[x, y, z]` (m).
+    pub position: [f64; 3],
+    /// Orientation as a unit quaternion `[x, y, z, w]`.
+    pub quaternion: [f64; 4],
+}
+
+impl LinkPose {
+    /// From an isometry.
+    pub fn from_isometry(iso: &Isometry3<f64>) -> Self {
+        let t = &iso.translation.vector;
+        let q = iso.rotation.quaternion();
+        Self {
+            position: [t.x, t.y, t.z],
+            quaternion: [q.i, q.j, q.k, q.w],
+        }
+    }
+}
+
+/// Output of `tsukami model fk`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FkReport {
+    /// Every link's pose in the model's root frame.
+    pub links: BTreeMap<String, LinkPose>,
+}
+
+/// Forward kinematics for named joint values (others 0; mimic joints
+/// follow their masters; setting a mimic, fixed or unknown joint is an error).
+pub fn fk<'a>(model: &RobotModel, joints: impl IntoIterator<Item = (&'a str, f64)>) -> Result<FkReport> {
+    let q = model.positions_from_named(joints)?;
+    let mut state = FkState::new(model);
+    model.forward_kinematics(&q, &mut state);
+    Ok(FkReport {
+        links: model
+            .links
+            .iter()
+            .zip(&state.poses)
+            .map(|(l, p)| (l.name.clone(), LinkPose::from_isometry(p)))
+            .collect(),
+    })
+}
+
+/// [`fk`] for many configurations; an error names the failing item.
+pub fn fk_batch(model: &RobotModel, configurations: &[BTreeMap<String, f64>]) -> Result<Vec<FkReport>> {
+    configurations
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            fk(model, c.iter().map(|(k, v)| (k.as_str(), *v)))
+                .map_err(|e| BodyError::Request(format!("batch item {i}: {e}")))
+        })
+        .collect()
+}
+
+/// An IK request (the CLI's arguments, or one item of `--batch`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IkRequest {
+    /// The link to place (`--link`).
+    #[serde(default)]
+    pub link: Option<String>,
+    /// `[x, y, z]` or `[x, y, z, qx, qy, qz, qw]` in the root frame.
+    pub target: Vec<f64>,
+    /// Joints that may move (`--joints`); default: every independent joint
+    /// between the root and the link.
+    #[serde(default)]
+    pub joints: Option<Vec<String>>,
+    /// Restart seed (`--seed`, default 0).
+    #[serde(default)]
+    pub seed: Option<u64>,
+}
+
+/// Output of `tsukami model ik`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IkReport {
+    /// True when the target was reached within tolerance.
+    pub ok: bool,
+    /// Values of the solved joints (the best found when `ok` is false).
+    pub joint_positions: BTreeMap<String, f64>,
+    /// Position error (m).
+    pub position_error: f64,
+    /// Orientation error (rad; 0 for position-only targets).
+    pub orientation_error: f64,
+    /// Solver iterations.
+    pub iterations: usize,
+    /// Attempts (random restarts + 1).
+    pub attempts: usize,
+    /// The link.
+    pub link: String,
+    /// Why it failed, when `ok` is false.
+    pub message: Option<String>,
+}
+
+/// Parses `x,y,z[,qx,qy,qz,qw]`.
+pub fn parse_target(text: &str) -> Result<Vec<f64>> {
+    let values = text
+        .split(',')
+        .map(|s| {
+            s.trim()
+                .parse::<f64>()
+                .map_err(|_| BodyError::Request(format!("target '{text}': '{s}' is not a number")))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    check_target(&values)?;
+    Ok(values)
+}
+
+/// Parses `NAME=VALUE`.
+pub fn parse_joint_assignment(text: &str) -> Result<(String, f64)> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| BodyError::Request(format!("joint '{text}': expected NAME=VALUE")))?;
+    let v = value
+        .trim()
+        .parse::<f64>()
+        .map_err(|_| BodyError::Request(format!("joint '{text}': '{value}' is not a number")))?;
+    Ok((name.trim().to_string(), v))
+}
+
+fn check_target(t: &[f64]) -> Result<()> {
+    if t.len() != 3 && t.len() != 7 {
+        return Err(BodyError::Request(format!(
+            "target has {} values; expected x,y,z or x,y,z,qx,qy,qz,qw",
+            t.len()
+        )));
+    }
+    if !t.iter().all(|v| v.is_finite()) {
+        return Err(BodyError::Request(format!("target {t:?} has a non-finite value")));
+    }
+    Ok(())
+}
+
+fn target_pose(t: &[f64]) -> Result<(Isometry3<f64>, bool)> {
+    check_target(t)?;
+    let tr = Translation3::new(t[0], t[1], t[2]);
+    if t.len() == 3 {
+        return Ok((Isometry3::from_parts(tr, UnitQuaternion::identity()), false));
+    }
+    let q = Quaternion::new(t[6], t[3], t[4], t[5]);
+    if q.norm() < 1e-9 {
+        return Err(BodyError::Request("target quaternion is zero".into()));
+    }
+    Ok((Isometry3::from_parts(tr, UnitQuaternion::from_quaternion(q)), true))
+}
+
+/// Solves one IK request from the model's rest pose.
+pub fn ik(model: &RobotModel, request: &IkRequest) -> Result<IkReport> {
+    ik_batch(model, std::slice::from_ref(request)).map(|mut v| v.remove(0))
+}
+
+/// Solves many requests; solvers are reused between items with the same
+/// link and joints. An invalid item (unknown link or joint, bad target) is
+/// an error naming the item; an unreachable target is `ok: false`.
+pub fn ik_batch(model: &RobotModel, requests: &[IkRequest]) -> Result<Vec<IkReport>> {
+    let rest = model.rest_positions();
+    let mut solvers: Vec<((usize, Vec<usize>), IkSolver<'_>)> = Vec::new();
+    let mut out = Vec::with_capacity(requests.len());
+    for (i, req) in requests.iter().enumerate() {
+        let item = |e: BodyError| {
+            if requests.len() == 1 {
+                e
+            } else {
+                BodyError::Request(format!("batch item {i}: {e}"))
+            }
+        };
+        let link_name = req
+            .link
+            .as_deref()
+            .ok_or_else(|| item(BodyError::Request("no link given".into())))?;
+        let link = model.link_id(link_name).map_err(item)?;
+        let joints = match &req.joints {
+            Some(names) => names
+                .iter()
+                .map(|n| model.joint_id(n))
+                .collect::<Result<Vec<_>>>()
+                .map_err(item)?,
+            None => model.independent_chain(link),
+        };
+        let (target, orientation) = target_pose(&req.target).map_err(item)?;
+        let key = (link, joints.clone());
+        let idx = match solvers.iter().position(|(k, _)| *k == key) {
+            Some(p) => p,
+            None => {
+                let sel = JointSelection::new(model, &joints).map_err(item)?;
+                let solver = IkSolver::new(model, link, sel, IkOptions::default()).map_err(item)?;
+                solvers.push((key, solver));
+                solvers.len() - 1
+            }
+        };
+        let solver = &mut solvers[idx].1;
+        solver.options_mut().seed = req.seed.unwrap_or(0);
+        let sol = solver.solve(&target, orientation, &rest, None);
+        out.push(IkReport {
+            ok: sol.ok,
+            joint_positions: joints
+                .iter()
+                .map(|&j| (model.joints[j].name.clone(), sol.q[j]))
+                .collect(),
+            position_error: sol.position_error,
+            orientation_error: sol.orientation_error,
+            iterations: sol.iterations,
+            attempts: sol.attempts,
+            link: link_name.to_string(),
+            message: (!sol.ok).then(|| {
+                format!(
+                    "no solution within tolerance after {} attempts (best position error {:.3e} m, orientation error {:.3e} rad)",
+                    sol.attempts, sol.position_error, sol.orientation_error
+                )
+            }),
+        });
+    }
+    Ok(out)
+}

@@ -1,0 +1,116 @@
+//! Inverse kinematics on the humanoid: success rate on reachable targets,
+//! limits, determinism, and whole-body joint lists.
+
+mod common;
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use tsukami_body::ik::{IkOptions, IkSolver, RIGHT_ARM, SQUAT, WAIST};
+use tsukami_body::kinematics::{FkState, JointSelection};
+
+fn arm_solver<'m>(m: &'m tsukami_body::RobotModel, extra: &[&str]) -> IkSolver<'m> {
+    let mut names: Vec<&str> = extra.to_vec();
+    names.extend(RIGHT_ARM);
+    let sel = JointSelection::from_names(m, &names).unwrap();
+    IkSolver::new(m, m.link_id("r_palm").unwrap(), sel, IkOptions::default()).unwrap()
+}
+
+#[test]
+fn arm_reaches_random_reachable_targets() {
+    let m = common::humanoid();
+    let palm = m.link_id("r_palm").unwrap();
+    let mut solver = arm_solver(&m, &[]);
+    let mut rng = common::rng(7);
+    let mut fk = FkState::new(&m);
+    let rest = m.rest_positions();
+    let arm: Vec<usize> = RIGHT_ARM.iter().map(|n| m.joint_id(n).unwrap()).collect();
+    let (mut ok, n) = (0, 1000);
+    let mut iterations = 0;
+    for _ in 0..n {
+        // A target made from a random in-limit arm configuration.
+        let mut q = rest.clone();
+        let r = common::random_q(&m, &mut rng);
+        for &j in &arm {
+            q[j] = r[j];
+        }
+        m.forward_kinematics(&q, &mut fk);
+        let target = *fk.pose(palm);
+        let sol = solver.solve(&target, true, &rest, None);
+        iterations += sol.iterations;
+        if sol.ok {
+            ok += 1;
+            // Within limits, and the reported error is the real one.
+            for &j in &arm {
+                let lim = m.joints[j].limits;
+                assert!(sol.q[j] >= lim.lower && sol.q[j] <= lim.upper);
+            }
+            m.forward_kinematics(&sol.q, &mut fk);
+            let p = fk.pose(palm);
+            assert!((p.translation.vector - target.translation.vector).norm() <= 1e-5);
+            assert!(p.rotation.angle_to(&target.rotation) <= 1e-4);
+            // Joints outside the list did not move.
+            for (j, (a, b)) in sol.q.iter().zip(&rest).enumerate() {
+                if !arm.contains(&j) && m.joints[j].mimic.is_none() {
+                    assert_eq!(a, b, "{}", m.joints[j].name);
+                }
+            }
+        }
+    }
+    eprintln!("arm IK: {ok}/{n} solved, mean {} iterations", iterations / n);
+    assert!(ok as f64 >= 0.99 * n as f64, "only {ok}/{n} solved");
+}
+
+#[test]
+fn deterministic_for_a_seed() {
+    let m = common::humanoid();
+    let mut solver = arm_solver(&m, &WAIST);
+    let target = Isometry3::from_parts(
+        Translation3::new(0.45, -0.35, 0.95),
+        UnitQuaternion::from_euler_angles(0.3, 1.2, -0.4),
+    );
+    let rest = m.rest_positions();
+    let a = solver.solve(&target, true, &rest, None);
+    let b = solver.solve(&target, true, &rest, None);
+    assert_eq!(a.q, b.q);
+    assert_eq!(a.iterations, b.iterations);
+}
+
+#[test]
+fn position_only_target() {
+    let m = common::humanoid();
+    let mut solver = arm_solver(&m, &[]);
+    let target = Isometry3::translation(0.35, -0.3, 1.05);
+    let sol = solver.solve(&target, false, &m.rest_positions(), None);
+    assert!(sol.ok, "{sol:?}");
+    assert_eq!(sol.orientation_error, 0.0);
+}
+
+#[test]
+fn squat_reaches_what_the_arm_cannot() {
+    let m = common::humanoid();
+    // A palm 0.30 m above the floor in front of the robot, palm facing
+    // sideways (+y): far below what the standing arm can reach.
+    let rot = UnitQuaternion::from_basis_unchecked(&[
+        Vector3::x(),  // fingers forward
+        -Vector3::z(), // y = z × x
+        Vector3::y(),  // palm normal to the left
+    ]);
+    let target = Isometry3::from_parts(Translation3::new(0.40, -0.25, 0.40), rot);
+    let rest = m.rest_positions();
+    let arm = arm_solver(&m, &[]).solve(&target, true, &rest, None);
+    assert!(!arm.ok, "arm alone should fail: {arm:?}");
+    let mut whole = vec![SQUAT];
+    whole.extend(WAIST);
+    let body = arm_solver(&m, &whole).solve(&target, true, &rest, None);
+    assert!(body.ok, "{body:?}");
+    assert!(body.q[m.joint_id(SQUAT).unwrap()] < -0.05);
+}
+
+#[test]
+fn bad_selections_are_errors() {
+    let m = common::humanoid();
+    assert!(JointSelection::from_names(&m, &["r_index_j4"]).is_err()); // mimic
+    assert!(JointSelection::from_names(&m, &["camera_joint"]).is_err()); // fixed
+    assert!(JointSelection::from_names(&m, &["no_such_joint"]).is_err());
+    let head = JointSelection::from_names(&m, &["head_yaw"]).unwrap();
+    assert!(IkSolver::new(&m, m.link_id("r_palm").unwrap(), head, IkOptions::default()).is_err());
+}

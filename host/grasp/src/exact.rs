@@ -1,0 +1,303 @@
+//! The exact reference: force closure and the weight test as conic programs
+//! (solved with `clarabel`), with exact friction cones and force limits.
+//!
+//! # Contact model
+//!
+//! Each contact force, in its contact frame `f = U_i [f_t1, f_t2, f_n]`, obeys
+//!
+//! * Coulomb friction, exactly: `‖(f_t1, f_t2)‖ ≤ μ f_n` (a second-order cone),
+//!   or with [`ConeModel::Polyhedral`] the `k`-sided pyramid inscribed in it
+//!   (edges on the circular cone, `k` facets at distance `μ cos(π/k) f_n`) —
+//!   the same pyramid [`crate::ferrari_canny`] uses, to compare like with like;
+//! * the force limit `f_n ≤ f_max,i` on the **normal component** — "|f| bounded by
+//!   f_max along the normal" in the contract. This is the model a finger's joint
+//!   torques give (they bound the force it presses with), it is what the
+//!   Ferrari–Canny pyramid with edges of normal component `f_max` describes, and
+//!   it keeps the force set a truncated cone. (`‖f‖ ≤ f_max` would be the
+//!   alternative; it is not used.)
+//!
+//! # Force closure
+//!
+//! Force closure — every wrench can be resisted, `G(K) = R⁶` — holds exactly
+//! when `G` has rank 6 and some internal force (`G f = 0`) lies strictly inside
+//! every cone (Murray, Li & Sastry, *A Mathematical Introduction to Robotic
+//! Manipulation*, Prop. 5.2). Proof sketch: with such an `f₀`, `G` maps the open
+//! set `int K` around `f₀` onto an open set around `0`, and a cone that contains
+//! a neighbourhood of 0 is everything; conversely take `f₁ ∈ int K`, balance
+//! `−G f₁` with some `f₂ ∈ K`, and `f₁ + f₂ ∈ int K` is internal. So one small
+//! conic program decides it exactly:
+//!
+//! ```text
+//! maximise τ  s.t.  Σ G_i U_i f_i = 0,  ‖f_t,i‖ ≤ μ f_n,i − τ,  f_n,i ≤ f_max,i
+//! ```
+//!
+//! plus a rank test of `G Gᵀ` (6×6 eigenvalues). Closure is `τ* > 0` and rank 6.
+//! `τ*` (newtons) — how far inside its cone every finger can squeeze — is
+//! returned as [`ExactClosure::squeeze_margin`]. This was preferred to
+//! "largest ball of wrenches resistible": containment of a ball in a Minkowski
+//! sum of cones is a min–max over directions, not one convex program, and the
+//! 12-direction (±e_k) variant needs 12 copies of the variables for the same
+//! yes/no answer.
+//!
+//! # Holding the weight
+//!
+//! ```text
+//! maximise s  s.t.  Σ G_i U_i f_i + s·w_ext = 0,  ‖f_t,i‖ ≤ μ f_n,i,  f_n,i ≤ f_max,i
+//! ```
+//!
+//! `s*` is the largest multiple of the external wrench (the weight at the centre
+//! of mass) the grasp can balance; the forces that do it are returned in the
+//! world frame. The weight is resisted when `s* ≥ 1`.
+//!
+//! Both programs have `3n + 1` variables; clarabel solves them in a few tens of
+//! iterations (see the bench `force_closure`).
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+use nalgebra::{Matrix6, SymmetricEigen, Vector3};
+
+use crate::grasp::Grasp;
+use crate::grasp_matrix::{contact_block, Wrench};
+
+/// Smallest eigenvalue of `G Gᵀ` relative to its largest for `G` to count as rank 6.
+pub const RANK_TOLERANCE: f64 = 1e-12;
+
+/// Relative squeeze margin `τ*/(μ·min f_max)` above which the conic solution
+/// counts as strictly inside the cones (clarabel's accuracy is ~1e-8).
+pub const SQUEEZE_TOLERANCE: f64 = 1e-7;
+
+/// The friction cone model of the exact method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ConeModel {
+    /// The exact Coulomb cone `‖f_t‖ ≤ μ f_n` (second-order cone).
+    #[default]
+    Circular,
+    /// The pyramid with `sides` edges inscribed in the Coulomb cone (linear constraints).
+    Polyhedral {
+        /// Number of edges, ≥ 3.
+        sides: usize,
+    },
+}
+
+/// Why the exact method failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ExactError {
+    /// A polyhedral cone needs at least three sides.
+    #[error("a polyhedral friction cone needs at least 3 sides, got {0}")]
+    TooFewSides(usize),
+    /// The external wrench is not finite.
+    #[error("the external wrench has a non-finite component")]
+    BadWrench,
+    /// The solver could not be set up.
+    #[error("conic solver setup failed: {0}")]
+    Setup(String),
+    /// The solver stopped without a solution.
+    #[error("conic solver stopped with status {0}")]
+    Solver(String),
+}
+
+/// Exact force-closure decision.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExactClosure {
+    /// `G` has rank 6 and some internal force lies strictly inside every cone.
+    pub force_closure: bool,
+    /// `τ*` (N): how far inside its cone every contact force can be while the
+    /// forces balance each other. `≤ 0` when no internal squeeze exists.
+    pub squeeze_margin: f64,
+    /// Numerical rank of `G` (0–6).
+    pub grasp_rank: usize,
+}
+
+/// Exact weight test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExactWeight {
+    /// Largest `s` with `G f + s·w_ext = 0` feasible (`≥ 0`).
+    pub weight_scale: f64,
+    /// Contact forces (world frame, N) balancing `weight_scale · w_ext`.
+    pub forces: Vec<Vector3<f64>>,
+}
+
+/// Both exact answers for one grasp.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExactTest {
+    /// Force closure.
+    pub closure: ExactClosure,
+    /// Weight scale and forces.
+    pub weight: ExactWeight,
+}
+
+impl ExactTest {
+    /// Whether the external wrench itself (scale 1) can be balanced.
+    pub fn resists_weight(&self) -> bool {
+        self.weight.weight_scale >= 1.0
+    }
+}
+
+/// Numerical rank of `G` from the eigenvalues of the 6×6 `G Gᵀ`.
+pub fn grasp_rank(grasp: &Grasp) -> usize {
+    let mut ggt = Matrix6::zeros();
+    for c in grasp.contacts() {
+        let g = contact_block(c, grasp.reference(), grasp.torque_scale());
+        ggt += g * g.transpose();
+    }
+    let eig = SymmetricEigen::new(ggt).eigenvalues;
+    let largest = eig.max();
+    eig.iter().filter(|&&l| l > RANK_TOLERANCE * largest).count()
+}
+
+/// Which extra scalar variable the program maximises.
+enum Extra<'a> {
+    /// `τ`, subtracted from every cone constraint (force closure).
+    Squeeze,
+    /// `s`, multiplying the external wrench in the balance (weight test).
+    Scale(&'a Wrench),
+}
+
+/// Builds and solves one of the two programs; returns `(x, extra*)`.
+fn solve(grasp: &Grasp, cone: ConeModel, extra: Extra<'_>) -> Result<(Vec<f64>, f64), ExactError> {
+    let n = grasp.len();
+    let nv = 3 * n + 1;
+    let xe = 3 * n; // index of the extra variable
+    let mu = grasp.mu();
+    let (mut ri, mut ci, mut vals) = (Vec::new(), Vec::new(), Vec::new());
+    let mut b = Vec::new();
+    let mut cones = Vec::new();
+    let mut row = 0;
+    let push = |r: usize, c: usize, v: f64, ri: &mut Vec<usize>, ci: &mut Vec<usize>, vals: &mut Vec<f64>| {
+        if v != 0.0 {
+            ri.push(r);
+            ci.push(c);
+            vals.push(v);
+        }
+    };
+
+    // Balance: Σ G_i U_i f_i (+ s w_ext) = 0  (slack in the zero cone).
+    for (i, c) in grasp.contacts().iter().enumerate() {
+        let gu = contact_block(c, grasp.reference(), grasp.torque_scale()) * c.frame();
+        for r in 0..6 {
+            for k in 0..3 {
+                push(row + r, 3 * i + k, gu[(r, k)], &mut ri, &mut ci, &mut vals);
+            }
+        }
+    }
+    if let Extra::Scale(w) = extra {
+        for r in 0..6 {
+            push(row + r, xe, w[r], &mut ri, &mut ci, &mut vals);
+        }
+    }
+    b.extend([0.0; 6]);
+    cones.push(SupportedConeT::ZeroConeT(6));
+    row += 6;
+
+    // Force limits: f_max,i − f_n,i ≥ 0.
+    for (i, &f_max) in grasp.force_limits().iter().enumerate() {
+        push(row + i, 3 * i + 2, 1.0, &mut ri, &mut ci, &mut vals);
+        b.push(f_max);
+    }
+    cones.push(SupportedConeT::NonnegativeConeT(n));
+    row += n;
+
+    // Friction: slack = b − A x inside the cone; τ enters with +1 in A.
+    let squeeze = matches!(extra, Extra::Squeeze);
+    match cone {
+        ConeModel::Circular => {
+            for i in 0..n {
+                // (μ f_n − τ, f_t1, f_t2) ∈ SOC₃
+                push(row, 3 * i + 2, -mu, &mut ri, &mut ci, &mut vals);
+                if squeeze {
+                    push(row, xe, 1.0, &mut ri, &mut ci, &mut vals);
+                }
+                push(row + 1, 3 * i, -1.0, &mut ri, &mut ci, &mut vals);
+                push(row + 2, 3 * i + 1, -1.0, &mut ri, &mut ci, &mut vals);
+                b.extend([0.0; 3]);
+                cones.push(SupportedConeT::SecondOrderConeT(3));
+                row += 3;
+            }
+        }
+        ConeModel::Polyhedral { sides } => {
+            if sides < 3 {
+                return Err(ExactError::TooFewSides(sides));
+            }
+            let half = std::f64::consts::PI / sides as f64;
+            let reach = mu * half.cos();
+            for i in 0..n {
+                for j in 0..sides {
+                    // Facet between edges j and j+1: its outward normal is at angle θ_j + π/k.
+                    let phi = 2.0 * half * j as f64 + half;
+                    // μ cos(π/k) f_n − (cos φ f_t1 + sin φ f_t2) − τ ≥ 0
+                    push(row, 3 * i, phi.cos(), &mut ri, &mut ci, &mut vals);
+                    push(row, 3 * i + 1, phi.sin(), &mut ri, &mut ci, &mut vals);
+                    push(row, 3 * i + 2, -reach, &mut ri, &mut ci, &mut vals);
+                    if squeeze {
+                        push(row, xe, 1.0, &mut ri, &mut ci, &mut vals);
+                    }
+                    b.push(0.0);
+                    row += 1;
+                }
+            }
+            cones.push(SupportedConeT::NonnegativeConeT(n * sides));
+        }
+    }
+
+    let a = CscMatrix::new_from_triplets(row, nv, ri, ci, vals);
+    let p = CscMatrix::zeros((nv, nv));
+    let mut q = vec![0.0; nv];
+    q[xe] = -1.0;
+    let settings = DefaultSettings {
+        verbose: false,
+        ..DefaultSettings::default()
+    };
+    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
+        .map_err(|e| ExactError::Setup(e.to_string()))?;
+    solver.solve();
+    match solver.solution.status {
+        SolverStatus::Solved | SolverStatus::AlmostSolved => {
+            let x = solver.solution.x.clone();
+            let e = x[xe];
+            Ok((x, e))
+        }
+        other => Err(ExactError::Solver(format!("{other:?}"))),
+    }
+}
+
+/// Exact force closure with cone model `cone` (see the module docs).
+pub fn exact_force_closure(grasp: &Grasp, cone: ConeModel) -> Result<ExactClosure, ExactError> {
+    let grasp_rank = grasp_rank(grasp);
+    let (_, tau) = solve(grasp, cone, Extra::Squeeze)?;
+    let f_min = grasp.force_limits().iter().copied().fold(f64::INFINITY, f64::min);
+    let force_closure = grasp_rank == 6 && tau > SQUEEZE_TOLERANCE * grasp.mu() * f_min;
+    Ok(ExactClosure {
+        force_closure,
+        squeeze_margin: tau,
+        grasp_rank,
+    })
+}
+
+/// The largest multiple of `external` (e.g. the weight wrench) the grasp can
+/// balance with cone model `cone`, and the world-frame contact forces doing it.
+pub fn exact_weight_scale(grasp: &Grasp, cone: ConeModel, external: &Wrench) -> Result<ExactWeight, ExactError> {
+    if !external.iter().all(|x| x.is_finite()) {
+        return Err(ExactError::BadWrench);
+    }
+    let (x, s) = solve(grasp, cone, Extra::Scale(external))?;
+    let forces = grasp
+        .contacts()
+        .iter()
+        .enumerate()
+        .map(|(i, c)| c.frame() * Vector3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]))
+        .collect();
+    Ok(ExactWeight {
+        weight_scale: s.max(0.0),
+        forces,
+    })
+}
+
+/// Both exact programs for one grasp.
+pub fn exact_test(grasp: &Grasp, cone: ConeModel, external: &Wrench) -> Result<ExactTest, ExactError> {
+    Ok(ExactTest {
+        closure: exact_force_closure(grasp, cone)?,
+        weight: exact_weight_scale(grasp, cone, external)?,
+    })
+}

@@ -1,0 +1,34 @@
+//! Property test: random contact sets on the 350 ml can and a box, every
+//! method against the exact reference (seeded, deterministic).
+//!
+//! The larger sweep whose figures are in `docs/force-closure.md` is the
+//! example `cargo run --release --example fc_agreement -p tsukami-grasp`.
+
+mod common;
+
+#[test]
+fn exact_agrees_with_ferrari_canny_and_the_inner_ellipsoid_never_lies() {
+    // 2 × 600 grasps of 3–6 contacts; ε_L∞ for the 3-contact ones.
+    let s = common::sweep(600, 0x75_6b_61_6d_69, &[3, 4, 5, 6], 8, 3);
+    println!("exact(8-pyramid) vs eps_L1 > 0: {}", s.exact_vs_l1);
+    println!("exact(8-pyramid) vs eps_Linf > 0: {}", s.exact_vs_linf);
+    println!("ellipsoid closure, delta_f = 0: {}", s.ellipsoid_closure);
+    println!("ellipsoid closure, delta_f = n-1: {}", s.ellipsoid_closure_inner);
+    println!("ellipsoid weight, delta_f = 0: {}", s.ellipsoid_weight);
+    println!("ellipsoid weight, delta_f = n-1: {}", s.ellipsoid_weight_inner);
+    println!("zero-FP delta_f (closure): {}", common::Sweep::zero_fp_delta(&s.closure_margins, None));
+    println!("zero-FP delta_f (weight): {}", common::Sweep::zero_fp_delta(&s.weight_margins, None));
+
+    // Same cone model, same answer (up to boundary cases of measure zero).
+    assert!(s.exact_vs_l1.agreement() >= 0.999, "{}", s.exact_vs_l1);
+    assert!(s.exact_vs_linf.agreement() >= 0.999, "{}", s.exact_vs_linf);
+    // The set must exercise both answers.
+    assert!(s.exact_vs_l1.true_pos > 100 && s.exact_vs_l1.true_neg > 100, "{}", s.exact_vs_l1);
+    // The inscribed pyramid is inside the cone: it can only lose closure.
+    assert_eq!(s.poly_vs_circular.false_pos, 0, "{}", s.poly_vs_circular);
+    // With threshold 1 (δf = n − 1) eq. (10) is an inner approximation of the
+    // Minkowski sum of ellipsoids that lie inside the bounded cones: a theorem,
+    // so not one false positive.
+    assert_eq!(s.ellipsoid_closure_inner.false_pos, 0, "{}", s.ellipsoid_closure_inner);
+    assert_eq!(s.ellipsoid_weight_inner.false_pos, 0, "{}", s.ellipsoid_weight_inner);
+}

@@ -1,0 +1,707 @@
+//! Messages of the grasp planner role (`tsukami/planner/*`).
+//!
+//! What: the request and reply payloads of the planner's queryables —
+//! [`SetRobot`], [`SetObject`], [`SetEnv`], [`RemoveEnv`], [`PlanOptions`] /
+//! [`PlanReply`], [`Stop`] — and the [`ProgressEvent`] it publishes while
+//! planning.
+//!
+//! Why: the same JSON travels in-process (through the plugin boundary) and over
+//! zenoh, so external tools (Python, the C client, the `tsukami demo`) rely on
+//! these field names. [`PlanReply`] carries the field contract of issue #5;
+//! fields may be added but never renamed.
+//!
+//! How: every request derives `Deserialize` with `deny_unknown_fields` so a typo
+//! in a field name is an error rather than a silently ignored option; every type
+//! derives [`schemars::JsonSchema`] so the schema can be published. Units are SI
+//! (metres, kilograms, radians, newtons); poses are in the world frame, which is
+//! the robot's `base_link` frame (on the floor between the feet, x forward, y
+//! left, z up); quaternions are `[x, y, z, w]`.
+//!
+//! ```
+//! use tsukami_msgs::planner::{PlanOptions, SetObject};
+//! let req: SetObject = serde_json::from_str(
+//!     r#"{"shape": {"model": {"name": "can_350ml"}}, "mass": 0.15,
+//!         "pose": {"position": [0.45, -0.2, 1.05], "quaternion": [0, 0, 0, 1]}}"#,
+//! ).unwrap();
+//! assert_eq!(req.mass, 0.15);
+//! let opts: PlanOptions = serde_json::from_str(r#"{"seed": 7}"#).unwrap();
+//! assert_eq!(opts.seed, 7);
+//! assert!(serde_json::from_str::<PlanOptions>(r#"{"sed": 7}"#).is_err());
+//! ```
+
+use std::collections::BTreeMap;
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// A rigid pose: position in metres and unit quaternion `[x, y, z, w]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Pose {
+    /// Position `[x, y, z]` in metres.
+    pub position: [f64; 3],
+    /// Orientation as a unit quaternion `[x, y, z, w]` (normalised by the receiver).
+    #[serde(default = "identity_quaternion")]
+    pub quaternion: [f64; 4],
+}
+
+fn identity_quaternion() -> [f64; 4] {
+    [0.0, 0.0, 0.0, 1.0]
+}
+
+impl Default for Pose {
+    fn default() -> Self {
+        Self {
+            position: [0.0; 3],
+            quaternion: identity_quaternion(),
+        }
+    }
+}
+
+impl Pose {
+    /// A pose at `position` with the identity orientation.
+    pub fn at(position: [f64; 3]) -> Self {
+        Self {
+            position,
+            quaternion: identity_quaternion(),
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// set_robot
+// ---------------------------------------------------------------------------
+
+/// `tsukami/planner/set_robot`: load the robot model and its hand's grasp types.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SetRobot {
+    /// Robot model: a URDF file path, or a robot name under `models/robots/`
+    /// (e.g. `"tsukami_humanoid"`).
+    pub robot: String,
+    /// Grasp-type configuration file (TOML, see `docs/grasp-types.md`). Default:
+    /// `grasp_types.toml` beside the URDF.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grasp_types: Option<String>,
+}
+
+/// Reply to [`SetRobot`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct RobotSummary {
+    /// Robot name from the URDF.
+    pub name: String,
+    /// Joints of the arm, shoulder to wrist.
+    pub arm_joints: Vec<String>,
+    /// Joints the whole-body fallback may add (waist, then squat).
+    pub body_joints: Vec<String>,
+    /// Actuated hand joints.
+    pub hand_joints: Vec<String>,
+    /// Names of the grasp types loaded from the configuration.
+    pub grasp_types: Vec<String>,
+}
+
+// ---------------------------------------------------------------------------
+// set_object
+// ---------------------------------------------------------------------------
+
+/// Where the object's geometry comes from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum ObjectShape {
+    /// A triangle mesh file (STL or OBJ), any object, seen before or not.
+    Mesh {
+        /// File path.
+        path: String,
+        /// Uniform scale applied to the file's coordinates (default 1; use 0.001 for millimetres).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        scale: Option<f64>,
+    },
+    /// An object model under `models/objects/` by name (e.g. `"can_350ml"`).
+    Model {
+        /// Model name.
+        name: String,
+    },
+}
+
+/// `tsukami/planner/set_object`: the object to grasp.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SetObject {
+    /// Display name (default: the model name or the file stem).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Geometry source.
+    pub shape: ObjectShape,
+    /// Mass in kg (must be > 0).
+    pub mass: f64,
+    /// Coulomb friction coefficient μ between fingers and object (default 0.5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
+    /// Pose of the object's mesh frame in the world.
+    pub pose: Pose,
+    /// Centre of mass in the object's mesh frame (default: the centroid of the
+    /// enclosed volume).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub center_of_mass: Option<[f64; 3]>,
+}
+
+/// A face of an OCP box, named by the box-frame axis of its outward normal.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+)]
+pub enum BoxFace {
+    /// Normal +x.
+    #[serde(rename = "+x")]
+    PosX,
+    /// Normal −x.
+    #[serde(rename = "-x")]
+    NegX,
+    /// Normal +y.
+    #[serde(rename = "+y")]
+    PosY,
+    /// Normal −y.
+    #[serde(rename = "-y")]
+    NegY,
+    /// Normal +z.
+    #[serde(rename = "+z")]
+    PosZ,
+    /// Normal −z.
+    #[serde(rename = "-z")]
+    NegZ,
+}
+
+impl BoxFace {
+    /// All six faces in a fixed order.
+    pub const ALL: [BoxFace; 6] = [
+        BoxFace::PosX,
+        BoxFace::NegX,
+        BoxFace::PosY,
+        BoxFace::NegY,
+        BoxFace::PosZ,
+        BoxFace::NegZ,
+    ];
+
+    /// Axis index (0 = x, 1 = y, 2 = z) of the face normal.
+    pub fn axis(self) -> usize {
+        match self {
+            BoxFace::PosX | BoxFace::NegX => 0,
+            BoxFace::PosY | BoxFace::NegY => 1,
+            BoxFace::PosZ | BoxFace::NegZ => 2,
+        }
+    }
+
+    /// Sign (+1 or −1) of the face normal along its axis.
+    pub fn sign(self) -> f64 {
+        match self {
+            BoxFace::PosX | BoxFace::PosY | BoxFace::PosZ => 1.0,
+            _ => -1.0,
+        }
+    }
+
+    /// The face from an axis index and a sign.
+    pub fn from_axis(axis: usize, positive: bool) -> BoxFace {
+        match (axis, positive) {
+            (0, true) => BoxFace::PosX,
+            (0, false) => BoxFace::NegX,
+            (1, true) => BoxFace::PosY,
+            (1, false) => BoxFace::NegY,
+            (_, true) => BoxFace::PosZ,
+            (_, false) => BoxFace::NegZ,
+        }
+    }
+
+    /// The name used on the wire (`"+x"`, `"-z"`, …).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            BoxFace::PosX => "+x",
+            BoxFace::NegX => "-x",
+            BoxFace::PosY => "+y",
+            BoxFace::NegY => "-y",
+            BoxFace::PosZ => "+z",
+            BoxFace::NegZ => "-z",
+        }
+    }
+}
+
+/// Why a face of an OCP box cannot be approached.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum FaceBlock {
+    /// The face rests on the support (table, shelf, floor) below it.
+    Support,
+    /// The face lies against another region of the same object.
+    Region,
+}
+
+/// One object convex polygon (OCP): an oriented box around one region of the object.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct OcpBox {
+    /// Region index (0-based, along the object's principal axis).
+    pub region: usize,
+    /// Box centre and orientation in the world frame.
+    pub pose: Pose,
+    /// Full edge lengths along the box axes, metres.
+    pub extents: [f64; 3],
+    /// Faces the hand may approach.
+    pub free_faces: Vec<BoxFace>,
+    /// Faces that are blocked, and why.
+    pub blocked_faces: Vec<(BoxFace, FaceBlock)>,
+}
+
+/// Reply to [`SetObject`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ObjectSummary {
+    /// Object name.
+    pub name: String,
+    /// Mass in kg.
+    pub mass: f64,
+    /// Centre of mass in the world frame.
+    pub center_of_mass: [f64; 3],
+    /// Triangle count of the mesh.
+    pub triangles: usize,
+    /// OCP boxes, one per region.
+    pub regions: Vec<OcpBox>,
+}
+
+// ---------------------------------------------------------------------------
+// set_env / remove_env
+// ---------------------------------------------------------------------------
+
+/// Geometry of an obstacle.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum ObstacleShape {
+    /// A box with full edge lengths `size`, centred on the obstacle pose.
+    Box {
+        /// Full edge lengths in metres.
+        size: [f64; 3],
+    },
+    /// A cylinder along its local z, centred on the obstacle pose.
+    Cylinder {
+        /// Radius in metres.
+        radius: f64,
+        /// Full height in metres.
+        height: f64,
+    },
+    /// A capsule along its local z, centred on the obstacle pose.
+    Capsule {
+        /// Radius in metres.
+        radius: f64,
+        /// Length of the cylindrical part in metres.
+        length: f64,
+    },
+    /// A sphere centred on the obstacle pose.
+    Sphere {
+        /// Radius in metres.
+        radius: f64,
+    },
+    /// A triangle mesh file (STL or OBJ).
+    Mesh {
+        /// File path.
+        path: String,
+        /// Uniform scale (default 1).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        scale: Option<f64>,
+    },
+}
+
+/// One named obstacle of the environment (table, fridge shelf, wall, …).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Obstacle {
+    /// Unique name; setting an existing name replaces that obstacle.
+    pub name: String,
+    /// Geometry.
+    pub shape: ObstacleShape,
+    /// Pose in the world frame.
+    pub pose: Pose,
+}
+
+/// `tsukami/planner/set_env`: add or replace obstacles.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SetEnv {
+    /// Obstacles to add (an existing name is replaced).
+    #[serde(default)]
+    pub obstacles: Vec<Obstacle>,
+    /// Remove every existing obstacle first.
+    #[serde(default)]
+    pub replace: bool,
+}
+
+/// `tsukami/planner/remove_env`: remove obstacles.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RemoveEnv {
+    /// Names to remove; an unknown name is an error and removes nothing.
+    #[serde(default)]
+    pub names: Vec<String>,
+    /// Remove all obstacles (then `names` is ignored).
+    #[serde(default)]
+    pub all: bool,
+}
+
+/// Reply to [`SetEnv`] and [`RemoveEnv`]: the obstacles now present.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct EnvSummary {
+    /// Obstacle names, sorted.
+    pub obstacles: Vec<String>,
+}
+
+// ---------------------------------------------------------------------------
+// plan
+// ---------------------------------------------------------------------------
+
+/// Criterion choosing among nominal palm poses (section 3.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum PalmCriterion {
+    /// The paper: minimum norm of the wrist joint angles.
+    #[default]
+    MinWristNorm,
+    /// graspPlugin's public code: minimum distance of all arm joints from the
+    /// middle of their ranges (normalised by the range).
+    MidRange,
+}
+
+/// How much of the body the planner may use (section 3.4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum WholeBody {
+    /// Arm only.
+    ArmOnly,
+    /// Arm, then arm + waist.
+    Waist,
+    /// Arm, then arm + waist, then arm + waist + squat (the default).
+    #[default]
+    Squat,
+}
+
+/// `tsukami/planner/plan`: options of one planning request.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PlanOptions {
+    /// Random seed; the same seed and state give the same result.
+    #[serde(default)]
+    pub seed: u64,
+    /// Maximum number of random samples of Algorithm 1 per candidate (default 300).
+    #[serde(default = "default_max_samples")]
+    pub max_samples: u32,
+    /// Wall-clock budget for the whole plan in milliseconds (default 5000).
+    #[serde(default = "default_time_budget_ms")]
+    pub time_budget_ms: u64,
+    /// Joints beyond the arm the planner may add when the arm alone fails.
+    #[serde(default)]
+    pub whole_body: WholeBody,
+    /// Nominal palm pose criterion.
+    #[serde(default)]
+    pub palm_criterion: PalmCriterion,
+    /// Required ellipsoid margin δf: stop when `n − f(p1..pn) ≥ δf` (default 0.05).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub delta_f: Option<f64>,
+    /// Restrict the search to these grasp-type names (default: all).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grasp_types: Option<Vec<String>>,
+    /// Maximum number of grasp-type candidates tried, in score order (default 6).
+    #[serde(default = "default_max_candidates")]
+    pub max_candidates: u32,
+}
+
+fn default_max_samples() -> u32 {
+    300
+}
+fn default_time_budget_ms() -> u64 {
+    5000
+}
+fn default_max_candidates() -> u32 {
+    6
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            max_samples: default_max_samples(),
+            time_budget_ms: default_time_budget_ms(),
+            whole_body: WholeBody::default(),
+            palm_criterion: PalmCriterion::default(),
+            delta_f: None,
+            grasp_types: None,
+            max_candidates: default_max_candidates(),
+        }
+    }
+}
+
+/// Grasp style of a reference posture.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum GraspStyle {
+    /// 3-finger fingertip grasp (thumb, index, middle).
+    Fingertip3,
+    /// 4-finger fingertip grasp.
+    Fingertip4,
+    /// 4-finger enveloping grasp.
+    Envelope4,
+}
+
+impl GraspStyle {
+    /// The name used on the wire.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            GraspStyle::Fingertip3 => "fingertip3",
+            GraspStyle::Fingertip4 => "fingertip4",
+            GraspStyle::Envelope4 => "envelope4",
+        }
+    }
+}
+
+/// Object size class of a reference posture.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum GraspSize {
+    /// Small objects.
+    Small,
+    /// Mid-sized objects.
+    Mid,
+    /// Large objects.
+    Large,
+}
+
+impl GraspSize {
+    /// The name used on the wire.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            GraspSize::Small => "small",
+            GraspSize::Mid => "mid",
+            GraspSize::Large => "large",
+        }
+    }
+}
+
+/// Which grasp type a plan used.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub struct GraspTypeRef {
+    /// Name from the grasp-type configuration (e.g. `"fingertip4_mid"`).
+    pub name: String,
+    /// Style.
+    pub style: GraspStyle,
+    /// Size class.
+    pub size: GraspSize,
+}
+
+/// One finger contact of the planned grasp, in the world frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ContactReply {
+    /// Finger link touching the object.
+    pub link: String,
+    /// Contact point on the object surface (metres, world frame).
+    pub position: [f64; 3],
+    /// Unit contact normal pointing into the object.
+    pub normal: [f64; 3],
+    /// Maximum normal force this finger can apply at this posture (N).
+    pub f_max: f64,
+}
+
+/// Object data the grasp was planned for, in the world frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ObjectMass {
+    /// Mass in kg.
+    pub mass: f64,
+    /// Centre of mass (metres, world frame).
+    pub center_of_mass: [f64; 3],
+}
+
+/// Force-closure verdicts of the planned grasp.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ForceClosureReply {
+    /// Ellipsoid margin `n − f(p1..pn)` of eq. (10) for the object's weight.
+    pub margin: f64,
+    /// Exact friction-cone test (second-order cone program): the contacts, each
+    /// within its friction cone and its `f_max`, can resist the weight.
+    pub exact_resists_weight: bool,
+}
+
+/// Time spent per phase, milliseconds.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+pub struct PhaseTiming {
+    /// Grasp-type selection, eqs. (1)–(5).
+    pub selection: f64,
+    /// Nominal palm poses and inverse kinematics (section 3.2, 3.4).
+    pub nominal_pose: f64,
+    /// Random posture search, Algorithm 1.
+    pub search: f64,
+    /// Exact force-closure verification of the result.
+    pub verification: f64,
+    /// Whole request.
+    pub total: f64,
+}
+
+/// Reply to [`PlanOptions`]: one planned grasp (the field contract of issue #5).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct PlanReply {
+    /// Grasp type used.
+    pub grasp_type: GraspTypeRef,
+    /// Index of the OCP region grasped.
+    pub ocp_region: usize,
+    /// Face of that OCP the hand approached.
+    pub face: BoxFace,
+    /// Palm (`r_palm` frame) pose in the world frame.
+    pub palm_pose: Pose,
+    /// Every joint used (waist, squat, arm, hand): name → position (rad or m).
+    pub joint_positions: BTreeMap<String, f64>,
+    /// Joints used beyond the arm (waist and squat joints); empty for arm only.
+    pub joints_used: Vec<String>,
+    /// Finger contacts in the world frame.
+    pub contacts: Vec<ContactReply>,
+    /// Friction coefficient used.
+    pub mu: f64,
+    /// Object mass and centre of mass.
+    pub object: ObjectMass,
+    /// Length (m) scaling torques to forces in wrenches, γ = 1 / length in eq. (6).
+    pub characteristic_length: f64,
+    /// Force-closure verdicts.
+    pub force_closure: ForceClosureReply,
+    /// Random samples drawn by Algorithm 1 over all candidates.
+    pub samples: u32,
+    /// Time per phase.
+    pub timing_ms: PhaseTiming,
+    /// Grasp-type candidates in score order (eq. (3)) that were tried.
+    pub candidates_tried: Vec<String>,
+}
+
+// ---------------------------------------------------------------------------
+// stop / progress
+// ---------------------------------------------------------------------------
+
+/// `tsukami/planner/stop`: cancel the running plan, if any.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Stop {}
+
+/// Reply to [`Stop`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct StopReply {
+    /// A plan was running and has been asked to stop.
+    pub stopped: bool,
+}
+
+/// Phase a [`ProgressEvent`] reports on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanPhase {
+    /// Grasp-type selection.
+    Selection,
+    /// Nominal palm pose and IK.
+    NominalPose,
+    /// Random posture search.
+    Search,
+    /// Exact verification.
+    Verification,
+    /// Finished (successfully or not).
+    Done,
+}
+
+/// `tsukami/planner/progress`: published while planning.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ProgressEvent {
+    /// Current phase.
+    pub phase: PlanPhase,
+    /// Grasp type being tried, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grasp_type: Option<String>,
+    /// Joints used beyond the arm at this stage.
+    #[serde(default)]
+    pub joints_used: Vec<String>,
+    /// Samples drawn so far.
+    pub samples: u32,
+    /// Best ellipsoid margin seen so far, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub best_margin: Option<f64>,
+    /// Milliseconds since the plan started.
+    pub elapsed_ms: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plan_reply_field_contract() {
+        let reply = PlanReply {
+            grasp_type: GraspTypeRef {
+                name: "fingertip4_mid".into(),
+                style: GraspStyle::Fingertip4,
+                size: GraspSize::Mid,
+            },
+            ocp_region: 0,
+            face: BoxFace::NegX,
+            palm_pose: Pose::default(),
+            joint_positions: BTreeMap::from([("r_elbow".to_string(), -1.0)]),
+            joints_used: vec!["squat_z".into()],
+            contacts: vec![ContactReply {
+                link: "r_index_l4".into(),
+                position: [0.0; 3],
+                normal: [1.0, 0.0, 0.0],
+                f_max: 5.0,
+            }],
+            mu: 0.5,
+            object: ObjectMass {
+                mass: 0.15,
+                center_of_mass: [0.0; 3],
+            },
+            characteristic_length: 0.05,
+            force_closure: ForceClosureReply {
+                margin: 0.3,
+                exact_resists_weight: true,
+            },
+            samples: 3,
+            timing_ms: PhaseTiming::default(),
+            candidates_tried: vec![],
+        };
+        let v = serde_json::to_value(&reply).unwrap();
+        assert_eq!(v["grasp_type"]["style"], "fingertip4");
+        assert_eq!(v["grasp_type"]["size"], "mid");
+        assert_eq!(v["face"], "-x");
+        assert_eq!(v["palm_pose"]["quaternion"].as_array().unwrap().len(), 4);
+        for key in [
+            "ocp_region",
+            "joint_positions",
+            "joints_used",
+            "mu",
+            "characteristic_length",
+            "samples",
+            "timing_ms",
+        ] {
+            assert!(v.get(key).is_some(), "missing {key}");
+        }
+        assert_eq!(v["contacts"][0]["f_max"], 5.0);
+        assert_eq!(v["object"]["mass"], 0.15);
+        assert_eq!(v["force_closure"]["exact_resists_weight"], true);
+        let back: PlanReply = serde_json::from_value(v).unwrap();
+        assert_eq!(back, reply);
+    }
+
+    #[test]
+    fn requests_reject_unknown_fields() {
+        assert!(serde_json::from_str::<SetRobot>(r#"{"robot":"x","urdf":"y"}"#).is_err());
+        assert!(serde_json::from_str::<SetEnv>(r#"{"obstacle":[]}"#).is_err());
+        assert!(serde_json::from_str::<Stop>(r#"{"now":true}"#).is_err());
+        let env: SetEnv = serde_json::from_str(
+            r#"{"obstacles":[{"name":"table","shape":{"box":{"size":[1,1,0.7]}},
+                "pose":{"position":[0.6,0,0.35]}}]}"#,
+        )
+        .unwrap();
+        assert_eq!(env.obstacles[0].pose.quaternion, [0.0, 0.0, 0.0, 1.0]);
+    }
+
+    #[test]
+    fn schema_is_generated() {
+        let schema = schemars::schema_for!(PlanReply);
+        let text = serde_json::to_string(&schema).unwrap();
+        assert!(text.contains("characteristic_length"));
+    }
+}

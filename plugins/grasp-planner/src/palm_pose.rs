@@ -1,0 +1,147 @@
+//! Nominal palm pose (section 3.2): lay the GRC on an OCP face, in four
+//! rotations, keep those that contain the object, and rank them.
+//!
+//! What: [`palm_targets`] gives, for one grasp type and one free OCP face, the
+//! palm poses of the (up to) four rotations of the GRC about the approach
+//! vector that pass the containment check; [`criterion_value`] scores an IK
+//! solution of one of them (the paper: minimum wrist-joint norm; graspPlugin's
+//! public code: distance from the middle of the arm joints' ranges).
+//!
+//! Why: the nominal pose is where Algorithm 1 starts sampling; a good one
+//! makes the search short. Rotations whose GRCmax cannot contain the OCP (or
+//! whose GRCmin is wider than the face) are dropped before any IK is solved.
+//!
+//! How: the GRC face with outward normal `−approach` is laid on the OCP face,
+//! so the approach vector points into the object (world `−n`). The in-plane
+//! GRC axes follow the face's two box axes in the four orders `(u, v)`,
+//! `(v, −u)`, `(−u, −v)`, `(−v, u)`. GRCdes's centre is placed on the OCP's
+//! centre, moved toward the face when the object is deeper than GRCdes (the
+//! hand then holds the part of the object nearest the face).
+
+use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use tsukami_body::model::JointId;
+use tsukami_msgs::planner::{BoxFace, PalmCriterion};
+
+use crate::grasp_type::GraspType;
+use crate::hand::HandModel;
+use crate::ocp::Ocp;
+use crate::selection::grc_edges_in_palm;
+
+/// One palm pose candidate on a face.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PalmTarget {
+    /// Rotation index 0–3 about the approach vector.
+    pub rotation: u8,
+    /// Palm pose in the world.
+    pub palm: Isometry3<f64>,
+}
+
+/// Palm poses of the four GRC rotations on `face` of `ocp` that pass the
+/// containment check of section 3.2.
+pub fn palm_targets(g: &GraspType, ocp: &Ocp, face: BoxFace) -> Vec<PalmTarget> {
+    let a = g.approach();
+    let ka = a.iamax();
+    let sa = a[ka].signum();
+    let (p1, p2) = ((ka + 1) % 3, (ka + 2) % 3);
+    let (max_p, _) = grc_edges_in_palm(&g.grc_max, &a);
+    let (min_p, _) = grc_edges_in_palm(&g.grc_min, &a);
+    let (des_p, _) = grc_edges_in_palm(&g.grc_des, &a);
+    let k = face.axis();
+    let n = ocp.face_normal(face);
+    let m = ocp.rotation.matrix();
+    let (iu, iv) = ((k + 1) % 3, (k + 2) % 3);
+    let (u, v) = (m.column(iu).into_owned(), m.column(iv).into_owned());
+    let (eu, ev) = (ocp.extents[iu], ocp.extents[iv]);
+    let depth = ocp.extents[k];
+    let shift = ((depth - des_p[ka]) * 0.5).max(0.0);
+    let target = ocp.center + n * shift;
+    let orders = [(u, v, eu, ev), (v, -u, ev, eu), (-u, -v, eu, ev), (-v, u, ev, eu)];
+    let mut out = Vec::new();
+    for (r, (d1, _d2, e1, e2)) in orders.into_iter().enumerate() {
+        // Containment: GRCmax holds the face, GRCmin fits on it.
+        let fits = e1 < max_p[p1] && e2 < max_p[p2] && e1 > min_p[p1] && e2 > min_p[p2];
+        if !fits {
+            continue;
+        }
+        // Columns: palm axis ka -> sa·(−n); p1 -> d1; p2 = ka × p1.
+        let mut cols = [Vector3::zeros(); 3];
+        cols[ka] = -n * sa;
+        cols[p1] = d1;
+        cols[p2] = cols[ka].cross(&cols[p1]);
+        let rot = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&cols));
+        let rot = UnitQuaternion::from_rotation_matrix(&rot);
+        let grc_centre = Vector3::from(g.grc_des.position);
+        let palm_pos = target.coords - rot * grc_centre;
+        out.push(PalmTarget {
+            rotation: r as u8,
+            palm: Isometry3::from_parts(Translation3::from(palm_pos), rot),
+        });
+    }
+    out
+}
+
+/// The palm-pose criterion for joint positions `q` (smaller is better).
+pub fn criterion_value(hand: &HandModel, q: &[f64], criterion: PalmCriterion, joints: &[JointId]) -> f64 {
+    match criterion {
+        // Section 3.2: "the minimum norm of joint angles of the wrist".
+        PalmCriterion::MinWristNorm => hand.wrist.iter().map(|&j| q[j] * q[j]).sum::<f64>().sqrt(),
+        PalmCriterion::MidRange => {
+            let s: f64 = joints
+                .iter()
+                .map(|&j| {
+                    let l = &hand.robot.joints[j].limits;
+                    let half = ((l.upper - l.lower) * 0.5).max(1e-9);
+                    let d = (q[j] - (l.upper + l.lower) * 0.5) / half;
+                    d * d
+                })
+                .sum();
+            s.sqrt()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grasp_type::GraspTypeConfig;
+    use nalgebra::Point3;
+
+    #[test]
+    fn approach_points_into_the_face_and_rotations_are_filtered() {
+        let cfg = GraspTypeConfig::from_toml_str(
+            &crate::grasp_type::tests::MINIMAL.replace(
+                "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.02, 0.02] }",
+                "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.09, 0.02] }",
+            ),
+        )
+        .unwrap();
+        let g = &cfg.grasp_types[0];
+        // A can standing at (0.5, 0, 1.061); axis 0 vertical.
+        let ocp = Ocp {
+            region: 0,
+            center: Point3::new(0.5, 0.0, 1.061),
+            rotation: Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[
+                Vector3::z(),
+                -Vector3::x(),
+                -Vector3::y(),
+            ])),
+            extents: Vector3::new(0.122, 0.066, 0.066),
+            blocked: [None; 6],
+        };
+        // Face +y of the box = world −x: facing the robot.
+        let t = palm_targets(g, &ocp, BoxFace::PosY);
+        // GRCmin's palm-y edge (0.09) only fits along the can's height: 2 of 4 rotations.
+        assert_eq!(t.len(), 2);
+        for p in &t {
+            let approach = p.palm.rotation * Vector3::z();
+            assert!((approach - Vector3::x()).norm() < 1e-9);
+            let palm_y = p.palm.rotation * Vector3::y();
+            assert!(palm_y.z.abs() > 0.999, "fingers stacked along the can");
+            // GRCdes centre on the OCP centre.
+            let c = p.palm * Point3::new(0.05, 0.0, 0.06);
+            assert!((c - ocp.center).norm() < 1e-9);
+        }
+        // The top is too narrow for this GRCmin.
+        assert!(palm_targets(g, &ocp, BoxFace::PosX).is_empty());
+    }
+}

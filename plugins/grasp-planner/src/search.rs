@@ -1,0 +1,357 @@
+//! Final posture search, the paper's Algorithm 1 (sections 3.4–3.5).
+//!
+//! What: [`search`] starts from one nominal palm pose and its IK solution and
+//! draws random offsets — Δp_p (the OCP's position w.r.t. the GRC, i.e. the
+//! palm position), Δp_s (the shoulder height, only in the squat stage) and Δa_i
+//! (each finger's pre-shape) — until the fingers close on the object without
+//! collision and the ellipsoid margin `n − f(p1..pn)` of eq. (10), for the
+//! object's weight and the fingers' maximum forces, reaches δf.
+//!
+//! Why: random sampling around a good nominal pose is what makes the paper's
+//! planner fast; the ellipsoid test costs well under a microsecond, so most
+//! time goes to IK and distance queries.
+//!
+//! How: the first sample is the nominal pose itself. Each sample solves the
+//! palm IK over the stage's joint list (warm-started from the nominal
+//! solution), sets the reference posture plus Δa, checks the open hand and arm
+//! against the environment and the object, closes the fingers
+//! ([`crate::finger_closing`]), checks again (contacting links may touch the
+//! object, nothing may touch the environment or the robot itself), then tests
+//! force closure. A grasp that passes the ellipsoid test is confirmed by the
+//! exact friction-cone test (`tsukami-grasp`) before it is returned. The
+//! generator is ChaCha8 seeded by the caller: the same seed, same result. The
+//! cancel flag and the deadline are checked before every sample (a sample
+//! takes well under a millisecond).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use tsukami_body::collision::CollisionObject;
+use tsukami_body::ik::{IkOptions, IkSolver};
+use tsukami_body::kinematics::{FkState, JointSelection};
+use tsukami_body::model::LinkId;
+use tsukami_grasp::contact::Contact;
+use tsukami_grasp::ellipsoid::{ellipsoid_test, EllipsoidModel};
+use tsukami_grasp::exact::{exact_test, ConeModel};
+use tsukami_grasp::grasp::Grasp;
+
+use crate::finger_closing::{close_fingers, FingerContact};
+use crate::hand::HandModel;
+use crate::object::PlanObject;
+use crate::whole_body::{Stage, StageJoints};
+
+/// Gravity (world frame, m/s²).
+pub const GRAVITY: Vector3<f64> = Vector3::new(0.0, 0.0, -9.81);
+
+/// Sampling ranges and thresholds of Algorithm 1.
+#[derive(Debug, Clone)]
+pub struct SearchParams {
+    /// Samples per nominal pose.
+    pub max_samples: u32,
+    /// Required ellipsoid margin δf.
+    pub delta_f: f64,
+    /// Half-range of Δp_p across the approach (m).
+    pub palm_offset: f64,
+    /// Half-range of Δp_p along the approach (m).
+    pub approach_offset: f64,
+    /// Half-range of Δa_i on each perturbed finger joint (rad).
+    pub finger_offset: f64,
+    /// Range of Δp_s, the squat offset (m), used in the squat stage.
+    pub squat_offset: (f64, f64),
+    /// Finger-closing distance threshold (m).
+    pub contact_distance: f64,
+}
+
+impl Default for SearchParams {
+    fn default() -> Self {
+        Self {
+            max_samples: 300,
+            delta_f: 0.05,
+            palm_offset: 0.015,
+            approach_offset: 0.01,
+            finger_offset: 0.12,
+            squat_offset: (-0.12, 0.04),
+            contact_distance: 0.002,
+        }
+    }
+}
+
+/// What the search works on.
+pub struct SearchContext<'a> {
+    /// The robot.
+    pub hand: &'a HandModel,
+    /// The object.
+    pub object: &'a PlanObject,
+    /// Obstacles.
+    pub env: &'a [&'a CollisionObject],
+    /// Set to stop.
+    pub cancel: &'a AtomicBool,
+    /// Give up after this instant.
+    pub deadline: Instant,
+    /// Parameters.
+    pub params: &'a SearchParams,
+}
+
+/// A grasp found by [`search`].
+#[derive(Debug, Clone)]
+pub struct Found {
+    /// Full joint vector.
+    pub q: Vec<f64>,
+    /// Palm pose (world).
+    pub palm: Isometry3<f64>,
+    /// Finger contacts.
+    pub contacts: Vec<FingerContact>,
+    /// Ellipsoid margin `n − f` for the weight.
+    pub margin: f64,
+    /// Exact test: the weight is resisted.
+    pub exact_resists_weight: bool,
+}
+
+/// How a search ended.
+#[derive(Debug, Clone)]
+pub enum Outcome {
+    /// A grasp was found.
+    Found(Box<Found>),
+    /// All samples were used.
+    Exhausted,
+    /// The cancel flag was set.
+    Cancelled,
+    /// The deadline passed.
+    OutOfTime,
+}
+
+/// Running counters shared across searches of one plan.
+#[derive(Debug, Clone, Default)]
+pub struct Counters {
+    /// Samples drawn.
+    pub samples: u32,
+    /// Best ellipsoid margin seen.
+    pub best_margin: Option<f64>,
+    /// Why samples were rejected: IK, collision before closing, closing, collision after, force closure.
+    pub rejections: [u32; 5],
+}
+
+/// Algorithm 1 around one nominal pose. `q_nominal` is the nominal IK solution
+/// (full vector) for grasp type `t` over `stage`.
+#[allow(clippy::too_many_arguments)]
+pub fn search(
+    ctx: &SearchContext<'_>,
+    t: usize,
+    stage: &StageJoints,
+    nominal_palm: &Isometry3<f64>,
+    q_nominal: &[f64],
+    seed: u64,
+    counters: &mut Counters,
+    progress: &mut dyn FnMut(&Counters),
+) -> Outcome {
+    let hand = ctx.hand;
+    let robot = &hand.robot;
+    let p = ctx.params;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let ik_opts = IkOptions {
+        max_attempts: 2,
+        max_iterations: 40,
+        position_tolerance: 1e-4,
+        orientation_tolerance: 1e-3,
+        seed,
+        ..IkOptions::default()
+    };
+    let Ok(sel) = JointSelection::new(robot, &stage.joints) else {
+        return Outcome::Exhausted;
+    };
+    let Ok(mut ik) = IkSolver::new(robot, hand.palm, sel, ik_opts.clone()) else {
+        return Outcome::Exhausted;
+    };
+    // In the squat stage, Δp_s fixes the squat joint and IK uses the rest.
+    let squat = (stage.stage == Stage::Squat).then_some(hand.squat).flatten();
+    let mut ik_no_squat = squat.and_then(|s| {
+        let joints: Vec<_> = stage.joints.iter().copied().filter(|&j| j != s).collect();
+        let sel = JointSelection::new(robot, &joints).ok()?;
+        IkSolver::new(robot, hand.palm, sel, ik_opts.clone()).ok()
+    });
+    let g = &hand.config.grasp_types[t];
+    let approach = g.approach();
+    let spec = &hand.types[t];
+    let contact_links: Vec<LinkId> = spec.contacts.iter().map(|c| c.link).collect();
+    let allowed: Vec<LinkId> = hand
+        .config
+        .hand
+        .touch_allowed
+        .iter()
+        .filter_map(|n| robot.link_id(n).ok())
+        .collect();
+    let moving: Vec<LinkId> = hand
+        .arm_links
+        .iter()
+        .chain(hand.hand_links.iter())
+        .copied()
+        .filter(|&l| !hand.collision.link_parts(l).is_empty())
+        .collect();
+    let not_touching: Vec<LinkId> = moving
+        .iter()
+        .copied()
+        .filter(|l| !contact_links.contains(l) && !allowed.contains(l))
+        .collect();
+    let object = &ctx.object.collision;
+    let mut fk = FkState::new(robot);
+    let mut q = q_nominal.to_vec();
+    for s in 0..p.max_samples {
+        if ctx.cancel.load(Ordering::Relaxed) {
+            return Outcome::Cancelled;
+        }
+        if Instant::now() >= ctx.deadline {
+            return Outcome::OutOfTime;
+        }
+        counters.samples += 1;
+        if counters.samples % 16 == 0 {
+            progress(counters);
+        }
+        // Δp_p: the OCP's offset w.r.t. the GRC moves the palm by −Δp_p.
+        let palm = if s == 0 {
+            *nominal_palm
+        } else {
+            let mut d = Vector3::new(
+                rng.random_range(-p.palm_offset..=p.palm_offset),
+                rng.random_range(-p.palm_offset..=p.palm_offset),
+                rng.random_range(-p.palm_offset..=p.palm_offset),
+            );
+            let along = d.dot(&approach);
+            d += approach * (along.clamp(-p.approach_offset, p.approach_offset) - along);
+            Isometry3::from_parts(
+                Translation3::from(nominal_palm.translation.vector - nominal_palm.rotation * d),
+                nominal_palm.rotation,
+            )
+        };
+        // Δp_s: the shoulder height, only where squatting is allowed.
+        q.copy_from_slice(q_nominal);
+        let sol = match (squat, ik_no_squat.as_mut()) {
+            (Some(sj), Some(solver)) if s > 0 => {
+                let l = &robot.joints[sj].limits;
+                q[sj] = (q_nominal[sj] + rng.random_range(p.squat_offset.0..=p.squat_offset.1))
+                    .clamp(l.lower, l.upper);
+                solver.solve(&palm, true, &q, Some(q_nominal))
+            }
+            _ => ik.solve(&palm, true, &q, Some(q_nominal)),
+        };
+        if !sol.ok {
+            counters.rejections[0] += 1;
+            continue;
+        }
+        q.copy_from_slice(&sol.q);
+        // Reference posture + Δa_i.
+        hand.set_posture(t, &mut q);
+        if s > 0 {
+            for c in &spec.contacts {
+                for &j in &c.perturb {
+                    let l = &robot.joints[j].limits;
+                    q[j] = (q[j] + rng.random_range(-p.finger_offset..=p.finger_offset))
+                        .clamp(l.lower, l.upper);
+                }
+            }
+            robot.apply_mimics(&mut q);
+        }
+        robot.forward_kinematics(&q, &mut fk);
+        if hand.collision.first_collision(&fk, &moving, ctx.env, 0.0).is_some()
+            || hand
+                .collision
+                .first_collision(&fk, &not_touching, &[object], 0.0)
+                .is_some()
+        {
+            counters.rejections[1] += 1;
+            continue;
+        }
+        let Some(contacts) = close_fingers(
+            hand,
+            t,
+            &mut q,
+            &mut fk,
+            object,
+            p.contact_distance,
+            g.closing_step,
+        ) else {
+            counters.rejections[2] += 1;
+            continue;
+        };
+        if hand.collision.first_collision(&fk, &moving, ctx.env, 0.0).is_some()
+            || hand
+                .collision
+                .first_collision(&fk, &not_touching, &[object], 0.0)
+                .is_some()
+            || hand.collision.first_self_collision(&fk, 0.0).is_some()
+        {
+            counters.rejections[3] += 1;
+            continue;
+        }
+        let Some((margin, grasp)) = ellipsoid_margin(ctx.object, &contacts) else {
+            counters.rejections[4] += 1;
+            continue;
+        };
+        if counters.best_margin.is_none_or(|b| margin > b) {
+            counters.best_margin = Some(margin);
+        }
+        if margin < p.delta_f {
+            counters.rejections[4] += 1;
+            continue;
+        }
+        // Confirm with the exact friction cones before answering.
+        let exact = exact_resists(ctx.object, &grasp);
+        if !exact {
+            counters.rejections[4] += 1;
+            continue;
+        }
+        progress(counters);
+        return Outcome::Found(Box::new(Found {
+            q,
+            palm,
+            contacts,
+            margin,
+            exact_resists_weight: exact,
+        }));
+    }
+    Outcome::Exhausted
+}
+
+/// The grasp of `contacts` on `object` (torques about the centre of mass).
+pub fn make_grasp(object: &PlanObject, contacts: &[FingerContact]) -> Option<Grasp> {
+    let cs = contacts
+        .iter()
+        .map(|c| Contact::new(c.position, c.normal).ok())
+        .collect::<Option<Vec<_>>>()?;
+    let limits = contacts.iter().map(|c| c.f_max.max(1e-6)).collect();
+    Grasp::with_force_limits(
+        cs,
+        limits,
+        object.mu,
+        object.characteristic_length,
+        object.center_of_mass,
+    )
+    .ok()
+}
+
+/// Eq. (10) margin `n − f(p1..pn)` for the object's weight.
+pub fn ellipsoid_margin(object: &PlanObject, contacts: &[FingerContact]) -> Option<(f64, Grasp)> {
+    let grasp = make_grasp(object, contacts)?;
+    let weight = grasp.weight_wrench(object.mass, &GRAVITY, &object.center_of_mass);
+    let test = ellipsoid_test(&grasp, &EllipsoidModel::default(), &weight);
+    if test.degenerate || !test.margin().is_finite() {
+        return None;
+    }
+    Some((test.margin(), grasp))
+}
+
+/// The exact test: the contacts, within circular friction cones and their
+/// force limits, balance the weight.
+pub fn exact_resists(object: &PlanObject, grasp: &Grasp) -> bool {
+    let weight = grasp.weight_wrench(object.mass, &GRAVITY, &object.center_of_mass);
+    exact_test(grasp, ConeModel::Circular, &weight)
+        .map(|t| t.resists_weight())
+        .unwrap_or(false)
+}
+
+/// Contact point helper for replies.
+pub fn to_array(p: &Point3<f64>) -> [f64; 3] {
+    [p.x, p.y, p.z]
+}

@@ -1,0 +1,105 @@
+//! Support for the end-to-end tests: private hosts on free loopback ports, the real
+//! plugin files cargo built, and the real `tsukami` binary.
+//!
+//! Every host here listens on `tcp/127.0.0.1:<free port>` with multicast scouting
+//! off, under a namespace of its own, so tests run in parallel without seeing each
+//! other and nothing leaves the machine.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+use tsukami::bus::{free_loopback_port, BusConfig};
+use tsukami::client::BusClient;
+use tsukami::config::{HostConfig, PluginEntryConfig};
+use tsukami::server::RunningHost;
+
+/// The folder cargo puts this test binary in (`target/<profile>/deps`) and its parent.
+fn build_dirs() -> Vec<PathBuf> {
+    let exe = std::env::current_exe().expect("current_exe");
+    let deps = exe.parent().expect("test binary folder").to_owned();
+    let profile = deps.parent().map(Path::to_owned).unwrap_or_else(|| deps.clone());
+    vec![deps, profile]
+}
+
+/// The library file cargo built for plugin crate `lib_name` (e.g. `tsukami_test_slow`).
+pub fn plugin_file(lib_name: &str) -> PathBuf {
+    let file = tsukami_plugin_api_file_name(lib_name);
+    build_dirs()
+        .into_iter()
+        .map(|d| d.join(&file))
+        .find(|p| p.is_file())
+        .unwrap_or_else(|| panic!("{file} was not built; is its crate a dev-dependency of tsukami-e2e?"))
+}
+
+fn tsukami_plugin_api_file_name(lib_name: &str) -> String {
+    format!("{}{lib_name}{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX)
+}
+
+/// A config entry loading `lib_name`'s file for `role`.
+pub fn plugin_entry(role: &str, lib_name: &str) -> PluginEntryConfig {
+    PluginEntryConfig { role: role.to_owned(), library: None, path: Some(plugin_file(lib_name)), config: None }
+}
+
+/// A host on a free loopback port with its own namespace, plus a connected client.
+pub struct TestBus {
+    /// The running host (dropped last).
+    pub host: RunningHost,
+    /// A client on its own zenoh session.
+    pub client: BusClient,
+    /// The endpoint the host listens on.
+    pub endpoint: String,
+}
+
+/// A host config on a free port, under a unique namespace, with `plugins`.
+pub fn test_config(plugins: Vec<PluginEntryConfig>) -> HostConfig {
+    let port = free_loopback_port().expect("free port");
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let mut config = HostConfig::empty(&format!("test-{port}"), BusConfig::listening(&endpoint));
+    config.plugins = plugins;
+    config
+}
+
+impl TestBus {
+    /// Starts a host with `config` and waits until it answers on the bus.
+    pub fn start(config: HostConfig) -> TestBus {
+        let endpoint = config.bus.listen[0].clone();
+        let host = RunningHost::start(&config).expect("host starts");
+        let client = BusClient::connect(&BusConfig::connecting(&endpoint), &config.namespace).expect("client connects");
+        client.wait_for_host(Duration::from_secs(20)).expect("host answers");
+        TestBus { host, client, endpoint }
+    }
+}
+
+/// The `tsukami` binary of this build. Cargo builds it for `cargo test --workspace`
+/// (the app has integration tests); when a narrower command did not, build it.
+pub fn tsukami_exe() -> PathBuf {
+    let name = format!("tsukami{}", std::env::consts::EXE_SUFFIX);
+    if let Some(found) = build_dirs().into_iter().map(|d| d.join(&name)).find(|p| p.is_file()) {
+        return found;
+    }
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    let status = Command::new(cargo).args(["build", "-p", "tsukami"]).status().expect("running cargo build");
+    assert!(status.success(), "cargo build -p tsukami failed");
+    build_dirs().into_iter().map(|d| d.join(&name)).find(|p| p.is_file()).expect("tsukami binary after build")
+}
+
+/// A child process killed when dropped.
+pub struct ChildGuard(pub Child);
+
+impl Drop for ChildGuard {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// Starts `tsukami <args>` as a child process with its output piped.
+pub fn spawn_tsukami(args: &[&str]) -> ChildGuard {
+    let child = Command::new(tsukami_exe())
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawning tsukami");
+    ChildGuard(child)
+}

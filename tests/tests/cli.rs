@@ -1,0 +1,50 @@
+//! The `tsukami` binary: `tsukami run` serving, `tsukami plugins` listing it.
+
+use tsukami::bus::free_loopback_port;
+use tsukami_e2e::{plugin_file, spawn_tsukami, tsukami_exe};
+
+#[test]
+fn plugins_lists_what_a_running_host_serves() {
+    let port = free_loopback_port().unwrap();
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let namespace = format!("cli-{port}");
+    let dir = std::env::temp_dir().join(format!("tsukami-cli-{port}"));
+    std::fs::create_dir_all(&dir).unwrap();
+    let config = dir.join("host.toml");
+    std::fs::write(
+        &config,
+        format!(
+            "namespace = \"{namespace}\"\n[bus]\nlisten = [\"{endpoint}\"]\n\n[[plugin]]\nrole = \"test-slow\"\npath = {:?}\n",
+            plugin_file("tsukami_test_slow")
+        ),
+    )
+    .unwrap();
+    let _host = spawn_tsukami(&["run", "--config", config.to_str().unwrap(), "--namespace", &namespace]);
+
+    // Ask until the host is up (a query before its queryable exists goes unanswered).
+    let mut listing = None;
+    for _ in 0..40 {
+        let out = std::process::Command::new(tsukami_exe())
+            .args(["plugins", "--connect", &endpoint, "--namespace", &namespace, "--timeout-ms", "500"])
+            .output()
+            .unwrap();
+        if out.status.success() {
+            listing = Some(serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap());
+            break;
+        }
+    }
+    let listing = listing.expect("tsukami plugins never got an answer");
+    assert_eq!(listing["namespace"], namespace.as_str());
+    assert_eq!(listing["plugins"][0]["roles"][0], "test-slow");
+    assert_eq!(listing["plugins"][0]["name"], "test-slow");
+    assert_eq!(listing["plugins"][0]["version"], env!("CARGO_PKG_VERSION"));
+
+    // The planner role is not served by this host: the client times out and says so.
+    let out = std::process::Command::new(tsukami_exe())
+        .args(["stop", "--connect", &endpoint, "--namespace", &namespace, "--timeout-ms", "300"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("no reply"), "{stderr}");
+}
