@@ -66,7 +66,10 @@ impl Part {
                 SharedShape::cylinder(length / 2.0, *radius),
                 Isometry3::from_parts(
                     nalgebra::Translation3::identity(),
-                    UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2),
+                    UnitQuaternion::from_axis_angle(
+                        &Vector3::x_axis(),
+                        std::f64::consts::FRAC_PI_2,
+                    ),
                 ),
                 false,
             ),
@@ -75,7 +78,9 @@ impl Part {
                 Isometry3::identity(),
                 false,
             ),
-            Geometry::Sphere { radius } => (SharedShape::ball(*radius), Isometry3::identity(), false),
+            Geometry::Sphere { radius } => {
+                (SharedShape::ball(*radius), Isometry3::identity(), false)
+            }
             Geometry::Mesh { path, mesh, .. } => {
                 let (trimesh, solid) = build_trimesh(mesh).map_err(|message| BodyError::Mesh {
                     file: path.clone(),
@@ -193,6 +198,9 @@ pub struct Proximity {
     pub object_part: usize,
 }
 
+/// Signed distance, witness points (link, object) and object normal.
+type PairProximity = (f64, Point3<f64>, Point3<f64>, Unit<Vector3<f64>>);
+
 /// Proximity between two placed shapes, or `None` if farther than
 /// `max_distance`.
 fn pair_proximity(
@@ -201,7 +209,7 @@ fn pair_proximity(
     pose2: &Pose,
     p2: &Part,
     max_distance: f64,
-) -> Option<(f64, Point3<f64>, Point3<f64>, Unit<Vector3<f64>>)> {
+) -> Option<PairProximity> {
     let w1 = *pose1 * p1.origin;
     let w2 = *pose2 * p2.origin;
     let cp = query::closest_points(&w1, &*p1.shape, &w2, &*p2.shape, max_distance).ok()?;
@@ -223,12 +231,7 @@ fn pair_proximity(
     }
 }
 
-fn penetration(
-    w1: &Pose,
-    p1: &Part,
-    w2: &Pose,
-    p2: &Part,
-) -> Option<(f64, Point3<f64>, Point3<f64>, Unit<Vector3<f64>>)> {
+fn penetration(w1: &Pose, p1: &Part, w2: &Pose, p2: &Part) -> Option<PairProximity> {
     match query::contact(w1, &*p1.shape, w2, &*p2.shape, 0.0) {
         Ok(Some(c)) => {
             let n = Unit::try_new(to_vector(c.normal2), 1e-12).unwrap_or(Vector3::z_axis());
@@ -278,7 +281,10 @@ fn pair_collides(pose1: &Pose, p1: &Part, pose2: &Pose, p2: &Part, margin: f64) 
     }
     // A shape wholly inside a closed mesh does not touch its surface.
     let inside = |wa: &Pose, pa: &Part, wb: &Pose, pb: &Part| {
-        pb.solid_mesh && pb.shape.contains_point(wb, pa.shape.compute_aabb(wa).center())
+        pb.solid_mesh
+            && pb
+                .shape
+                .contains_point(wb, pa.shape.compute_aabb(wa).center())
     };
     inside(&w1, p1, &w2, p2) || inside(&w2, p2, &w1, p1)
 }
@@ -436,7 +442,9 @@ impl RobotCollision {
     /// The first pair of links, not allowed to touch, that come closer than
     /// `margin`; `None` when the robot is free of self-collision.
     pub fn first_self_collision(&self, fk: &FkState, margin: f64) -> Option<(LinkId, LinkId)> {
-        self.self_collision_pairs(fk, margin, true).into_iter().next()
+        self.self_collision_pairs(fk, margin, true)
+            .into_iter()
+            .next()
     }
 
     /// Every pair of links, not allowed to touch, that come closer than
@@ -445,7 +453,12 @@ impl RobotCollision {
         self.self_collision_pairs(fk, margin, false)
     }
 
-    fn self_collision_pairs(&self, fk: &FkState, margin: f64, first: bool) -> Vec<(LinkId, LinkId)> {
+    fn self_collision_pairs(
+        &self,
+        fk: &FkState,
+        margin: f64,
+        first: bool,
+    ) -> Vec<(LinkId, LinkId)> {
         let mut out = Vec::new();
         for (ia, &a) in self.with_geometry.iter().enumerate() {
             let pa = to_pose(fk.pose(a));

@@ -195,21 +195,18 @@ impl<'m> IkSolver<'m> {
             })
             .unzip();
         let n = selection.len();
+        let poses = vec![Isometry3::identity(); path.len() + 1];
         Ok(Self {
             model,
             link,
             path,
             movers,
-            poses: vec![Isometry3::identity(); 0],
+            poses,
             cols: vec![Vector6::zeros(); n],
             lower,
             upper,
             selection,
             options,
-        })
-        .map(|mut s: Self| {
-            s.poses = vec![Isometry3::identity(); s.path.len() + 1];
-            s
         })
     }
 
@@ -265,9 +262,15 @@ impl<'m> IkSolver<'m> {
         for (c, &j) in self.selection.joints.iter().enumerate() {
             q[j] = q[j].clamp(self.lower[c], self.upper[c]);
         }
-        let w_o = if orientation { opts.orientation_weight } else { 0.0 };
+        let w_o = if orientation {
+            opts.orientation_weight
+        } else {
+            0.0
+        };
         let target_p = Point3::from(target.translation.vector);
-        let mut best: Option<(f64, f64, f64, Vec<f64>)> = None;
+        // Best configuration seen so far: (score, position error, orientation error).
+        let mut best = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
+        let mut best_q = q.clone();
         let mut iterations = 0;
         let mut dq = vec![0.0; n];
         let mut locked = vec![false; n];
@@ -289,8 +292,9 @@ impl<'m> IkSolver<'m> {
                     nalgebra::Vector3::zeros()
                 };
                 let (pe, oe) = (ep.norm(), eo.norm());
-                if best.as_ref().is_none_or(|b| pe + w_o * oe < b.0) {
-                    best = Some((pe + w_o * oe, pe, oe, q.clone()));
+                if pe + w_o * oe < best.0 {
+                    best = (pe + w_o * oe, pe, oe);
+                    best_q.copy_from_slice(&q);
                 }
                 if pe <= opts.position_tolerance && oe <= opts.orientation_tolerance {
                     self.model.apply_mimics(&mut q);
@@ -322,12 +326,27 @@ impl<'m> IkSolver<'m> {
                         JointKind::Prismatic => Vector6::new(axis.x, axis.y, axis.z, 0.0, 0.0, 0.0),
                         _ => {
                             let lin = axis.cross(&(p - Point3::from(child.translation.vector)));
-                            Vector6::new(lin.x, lin.y, lin.z, w_o * axis.x, w_o * axis.y, w_o * axis.z)
+                            Vector6::new(
+                                lin.x,
+                                lin.y,
+                                lin.z,
+                                w_o * axis.x,
+                                w_o * axis.y,
+                                w_o * axis.z,
+                            )
                         }
                     };
                     self.cols[pj.column] += col * pj.multiplier;
                 }
                 let lambda = energy + opts.min_damping;
+                // The damped pseudo-inverse leaks a little of the null-space
+                // pull into the task; near the goal that leak would stall
+                // convergence, so the pull fades out below 1 mm / ~2 mrad.
+                let gain = if e.norm() > 1e-3 {
+                    opts.null_space_gain
+                } else {
+                    0.0
+                };
                 locked.iter_mut().for_each(|l| *l = false);
                 for _pass in 0..4 {
                     let mut a = Matrix6::identity() * lambda;
@@ -344,11 +363,11 @@ impl<'m> IkSolver<'m> {
                             dq[c] = 0.0;
                             continue;
                         }
-                        let z = opts.null_space_gain * (rest[c] - q[j]);
+                        let z = gain * (rest[c] - q[j]);
                         dq[c] = self.cols[c].dot(&y) + z;
                         jz += self.cols[c] * z;
                     }
-                    if opts.null_space_gain != 0.0 {
+                    if gain != 0.0 {
                         let w = chol.solve(&jz);
                         for c in 0..n {
                             if !locked[c] {
@@ -377,13 +396,12 @@ impl<'m> IkSolver<'m> {
                 }
             }
         }
-        let (_, pe, oe, mut q) = best.unwrap_or((f64::INFINITY, f64::INFINITY, f64::INFINITY, q));
-        self.model.apply_mimics(&mut q);
+        self.model.apply_mimics(&mut best_q);
         IkSolution {
             ok: false,
-            q,
-            position_error: pe,
-            orientation_error: oe,
+            q: best_q,
+            position_error: best.1,
+            orientation_error: best.2,
             iterations,
             attempts: opts.max_attempts.max(1),
         }

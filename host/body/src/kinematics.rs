@@ -136,10 +136,7 @@ impl JointSelection {
     /// Column of joint `j`, if selected.
     #[inline]
     pub fn column(&self, j: JointId) -> Option<usize> {
-        self.column_of
-            .get(j)
-            .copied()
-            .filter(|&c| c != usize::MAX)
+        self.column_of.get(j).copied().filter(|&c| c != usize::MAX)
     }
 }
 
@@ -193,7 +190,9 @@ impl RobotModel {
                 Some(m) => (m.master, m.master_multiplier),
                 None => (j, 1.0),
             };
-            let Some(c) = selection.column(master) else { continue };
+            let Some(c) = selection.column(master) else {
+                continue;
+            };
             // The child frame shares the joint's axis and (for revolute
             // joints) its origin.
             let child = &fk.poses[joint.child];

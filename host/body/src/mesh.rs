@@ -238,7 +238,13 @@ impl TriangleMesh {
             .collect();
         self.indices
             .iter()
-            .map(|t| [remap[t[0] as usize], remap[t[1] as usize], remap[t[2] as usize]])
+            .map(|t| {
+                [
+                    remap[t[0] as usize],
+                    remap[t[1] as usize],
+                    remap[t[2] as usize],
+                ]
+            })
             .collect()
     }
 
@@ -462,7 +468,9 @@ mod tests {
         }
         let bad = dir.join("bad.stl");
         std::fs::write(&bad, b"solid x\nendsolid x\n").unwrap();
-        let err = TriangleMesh::load(&bad, Vector3::repeat(1.0)).unwrap_err().to_string();
+        let err = TriangleMesh::load(&bad, Vector3::repeat(1.0))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("bad.stl"), "{err}");
         std::fs::remove_dir_all(&dir).ok();
     }

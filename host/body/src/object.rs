@@ -107,7 +107,10 @@ impl ObjectModel {
             return Err(bad("mass", format!("{mass} must be finite and > 0")));
         }
         if !(friction.is_finite() && friction >= 0.0) {
-            return Err(bad("friction", format!("{friction} must be finite and >= 0")));
+            return Err(bad(
+                "friction",
+                format!("{friction} must be finite and >= 0"),
+            ));
         }
         let mesh = geometry_mesh(&geometry);
         Ok(Self {

@@ -150,7 +150,10 @@ pub struct FkReport {
 
 /// Forward kinematics for named joint values (others 0; mimic joints
 /// follow their masters; setting a mimic, fixed or unknown joint is an error).
-pub fn fk<'a>(model: &RobotModel, joints: impl IntoIterator<Item = (&'a str, f64)>) -> Result<FkReport> {
+pub fn fk<'a>(
+    model: &RobotModel,
+    joints: impl IntoIterator<Item = (&'a str, f64)>,
+) -> Result<FkReport> {
     let q = model.positions_from_named(joints)?;
     let mut state = FkState::new(model);
     model.forward_kinematics(&q, &mut state);
@@ -165,7 +168,10 @@ pub fn fk<'a>(model: &RobotModel, joints: impl IntoIterator<Item = (&'a str, f64
 }
 
 /// [`fk`] for many configurations; an error names the failing item.
-pub fn fk_batch(model: &RobotModel, configurations: &[BTreeMap<String, f64>]) -> Result<Vec<FkReport>> {
+pub fn fk_batch(
+    model: &RobotModel,
+    configurations: &[BTreeMap<String, f64>],
+) -> Result<Vec<FkReport>> {
     configurations
         .iter()
         .enumerate()
@@ -249,7 +255,9 @@ fn check_target(t: &[f64]) -> Result<()> {
         )));
     }
     if !t.iter().all(|v| v.is_finite()) {
-        return Err(BodyError::Request(format!("target {t:?} has a non-finite value")));
+        return Err(BodyError::Request(format!(
+            "target {t:?} has a non-finite value"
+        )));
     }
     Ok(())
 }
@@ -264,7 +272,10 @@ fn target_pose(t: &[f64]) -> Result<(Isometry3<f64>, bool)> {
     if q.norm() < 1e-9 {
         return Err(BodyError::Request("target quaternion is zero".into()));
     }
-    Ok((Isometry3::from_parts(tr, UnitQuaternion::from_quaternion(q)), true))
+    Ok((
+        Isometry3::from_parts(tr, UnitQuaternion::from_quaternion(q)),
+        true,
+    ))
 }
 
 /// Solves one IK request from the model's rest pose.
@@ -334,4 +345,203 @@ pub fn ik_batch(model: &RobotModel, requests: &[IkRequest]) -> Result<Vec<IkRepo
         });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn humanoid() -> RobotModel {
+        let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../models/robots/tsukami_humanoid/tsukami_humanoid.urdf");
+        crate::urdf::load_urdf(&p).unwrap()
+    }
+
+    #[test]
+    fn inspect_json_contract() {
+        let m = humanoid();
+        let v = serde_json::to_value(inspect(&m)).unwrap();
+        let links = v["links"].as_array().unwrap();
+        assert_eq!(links[0]["name"], "base_link");
+        assert!(links[0]["mass"].as_f64().unwrap() > 0.0);
+        let joints = v["joints"].as_array().unwrap();
+        let find = |n: &str| joints.iter().find(|j| j["name"] == n).unwrap().clone();
+        let squat = find("squat_z");
+        assert_eq!(squat["type"], "prismatic");
+        assert_eq!(squat["parent"], "base_link");
+        assert_eq!(squat["child"], "pelvis");
+        assert_eq!(squat["lower"].as_f64(), Some(-0.4));
+        assert_eq!(squat["upper"].as_f64(), Some(0.0));
+        assert!(
+            squat["effort"].as_f64().unwrap() > 0.0 && squat["velocity"].as_f64().unwrap() > 0.0
+        );
+        assert!(squat["mimic"].is_null());
+        let j4 = find("r_index_j4");
+        assert_eq!(j4["mimic"]["joint"], "r_index_j3");
+        assert_eq!(j4["mimic"]["multiplier"], 1.0);
+        assert_eq!(j4["mimic"]["offset"], 0.0);
+        let cam = find("camera_joint");
+        assert_eq!(cam["type"], "fixed");
+        assert!(cam["lower"].is_null() && cam["upper"].is_null());
+    }
+
+    #[test]
+    fn fk_json_contract_and_errors() {
+        let m = humanoid();
+        let r = fk(&m, [("squat_z", -0.2), ("r_index_j3", 0.5)]).unwrap();
+        let v = serde_json::to_value(&r).unwrap();
+        let pelvis = &v["links"]["pelvis"];
+        assert!((pelvis["position"][2].as_f64().unwrap() - 0.65).abs() < 1e-12);
+        assert_eq!(pelvis["quaternion"].as_array().unwrap().len(), 4);
+        assert_eq!(pelvis["quaternion"][3].as_f64(), Some(1.0)); // [x, y, z, w]
+                                                                 // The mimic joint followed its master: l4 is rotated further than l3.
+        let q3 = r.links["r_index_l3"].quaternion;
+        let q4 = r.links["r_index_l4"].quaternion;
+        assert_ne!(q3, q4);
+        // Errors: a mimic joint, an unknown joint, a fixed joint.
+        let e = fk(&m, [("r_index_j4", 0.1)]).unwrap_err().to_string();
+        assert!(e.contains("r_index_j4") && e.contains("mimic"), "{e}");
+        assert!(fk(&m, [("nope", 0.1)])
+            .unwrap_err()
+            .to_string()
+            .contains("nope"));
+        assert!(fk(&m, [("camera_joint", 0.1)]).is_err());
+        assert!(fk(&m, [("r_elbow", f64::NAN)]).is_err());
+        // Batch: one report per configuration; an error names the item.
+        let batch: Vec<BTreeMap<String, f64>> =
+            serde_json::from_str(r#"[{"r_elbow": -1.0}, {}]"#).unwrap();
+        assert_eq!(fk_batch(&m, &batch).unwrap().len(), 2);
+        let bad: Vec<BTreeMap<String, f64>> =
+            serde_json::from_str(r#"[{}, {"r_ring_j4": 1.0}]"#).unwrap();
+        assert!(fk_batch(&m, &bad)
+            .unwrap_err()
+            .to_string()
+            .contains("batch item 1"));
+    }
+
+    #[test]
+    fn ik_json_contract_and_errors() {
+        let m = humanoid();
+        // A target made by FK, so it is reachable.
+        let target = fk(
+            &m,
+            [
+                ("r_elbow", -1.2),
+                ("r_shoulder_pitch", -0.5),
+                ("r_wrist_pitch", 0.3),
+            ],
+        )
+        .unwrap();
+        let p = target.links["r_palm"];
+        let mut t = p.position.to_vec();
+        t.extend(p.quaternion);
+        let arm: Vec<String> = crate::ik::RIGHT_ARM.iter().map(|s| s.to_string()).collect();
+        let req = IkRequest {
+            link: Some("r_palm".into()),
+            target: t.clone(),
+            joints: Some(arm.clone()),
+            seed: Some(3),
+        };
+        let r = ik(&m, &req).unwrap();
+        assert!(r.ok, "{r:?}");
+        let v = serde_json::to_value(&r).unwrap();
+        for key in [
+            "ok",
+            "joint_positions",
+            "position_error",
+            "orientation_error",
+            "iterations",
+        ] {
+            assert!(v.get(key).is_some(), "{key}");
+        }
+        assert_eq!(v["joint_positions"].as_object().unwrap().len(), 7);
+        // Default joint list: the whole chain (squat, waist, arm).
+        let r = ik(
+            &m,
+            &IkRequest {
+                joints: None,
+                ..req.clone()
+            },
+        )
+        .unwrap();
+        assert!(r.ok && r.joint_positions.contains_key("squat_z"));
+        // Position only.
+        let r = ik(
+            &m,
+            &IkRequest {
+                target: t[..3].to_vec(),
+                ..req.clone()
+            },
+        )
+        .unwrap();
+        assert!(r.ok && r.orientation_error == 0.0);
+        // Unreachable: ok false with a message, not an error.
+        let r = ik(
+            &m,
+            &IkRequest {
+                target: vec![3.0, 0.0, 1.0],
+                ..req.clone()
+            },
+        )
+        .unwrap();
+        assert!(!r.ok && r.message.is_some());
+        // Errors.
+        assert!(ik(
+            &m,
+            &IkRequest {
+                link: Some("nope".into()),
+                ..req.clone()
+            }
+        )
+        .is_err());
+        assert!(ik(
+            &m,
+            &IkRequest {
+                joints: Some(vec!["r_index_j4".into()]),
+                ..req.clone()
+            }
+        )
+        .is_err());
+        assert!(ik(
+            &m,
+            &IkRequest {
+                target: vec![1.0, 2.0],
+                ..req.clone()
+            }
+        )
+        .is_err());
+        assert!(ik(
+            &m,
+            &IkRequest {
+                target: vec![0.3, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+                ..req.clone()
+            }
+        )
+        .is_err());
+        // Batch from JSON, with per-item overrides; deterministic.
+        let items: Vec<IkRequest> = serde_json::from_str(&format!(
+            r#"[{{"link": "r_palm", "target": {t:?}}}, {{"link": "r_palm", "target": [0.35, -0.3, 1.05], "joints": {arm:?}, "seed": 9}}]"#
+        ))
+        .unwrap();
+        let a = ik_batch(&m, &items).unwrap();
+        let b = ik_batch(&m, &items).unwrap();
+        assert_eq!(a, b);
+        assert!(a.iter().all(|r| r.ok));
+        let bad: Result<Vec<IkRequest>, _> =
+            serde_json::from_str(r#"[{"target": [0,0,1], "colour": 1}]"#);
+        assert!(bad.is_err());
+    }
+
+    #[test]
+    fn parsers() {
+        assert_eq!(parse_target("0.1, 0.2,0.3").unwrap(), vec![0.1, 0.2, 0.3]);
+        assert!(parse_target("0.1,0.2").is_err());
+        assert!(parse_target("0.1,x,0.3").is_err());
+        assert_eq!(
+            parse_joint_assignment("r_elbow=-1.5").unwrap(),
+            ("r_elbow".to_string(), -1.5)
+        );
+        assert!(parse_joint_assignment("r_elbow").is_err());
+        assert!(parse_joint_assignment("r_elbow=abc").is_err());
+    }
 }

@@ -104,7 +104,11 @@ impl ShapeSpec {
         };
         Ok(match self {
             ShapeSpec::Box { size } => Geometry::Box {
-                size: Vector3::new(pos("size", size[0])?, pos("size", size[1])?, pos("size", size[2])?),
+                size: Vector3::new(
+                    pos("size", size[0])?,
+                    pos("size", size[1])?,
+                    pos("size", size[2])?,
+                ),
             },
             ShapeSpec::Cylinder { radius, length } => Geometry::Cylinder {
                 radius: pos("radius", *radius)?,

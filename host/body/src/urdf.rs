@@ -189,7 +189,10 @@ impl Builder {
             if p == c {
                 return Err(BodyError::Loop {
                     file: self.file.clone(),
-                    message: format!("joint '{}' connects link '{}' to itself", j.name, j.parent.link),
+                    message: format!(
+                        "joint '{}' connects link '{}' to itself",
+                        j.name, j.parent.link
+                    ),
                 });
             }
             if let Some(other) = parent_joint[c] {
@@ -241,7 +244,10 @@ impl Builder {
                 .collect();
             return Err(BodyError::Loop {
                 file: self.file.clone(),
-                message: format!("links {names:?} form a cycle not connected to root link '{}'", robot.links[root].name),
+                message: format!(
+                    "links {names:?} form a cycle not connected to root link '{}'",
+                    robot.links[root].name
+                ),
             });
         }
         let mut new_link = vec![0usize; robot.links.len()];
@@ -267,7 +273,12 @@ impl Builder {
                     .iter()
                     .enumerate()
                     .map(|(i, v)| {
-                        self.element(&format!("link '{}' visual {i}", l.name), &v.name, &v.origin, &v.geometry)
+                        self.element(
+                            &format!("link '{}' visual {i}", l.name),
+                            &v.name,
+                            &v.origin,
+                            &v.geometry,
+                        )
                     })
                     .collect::<Result<_>>()?,
                 collisions: l
@@ -275,7 +286,12 @@ impl Builder {
                     .iter()
                     .enumerate()
                     .map(|(i, c)| {
-                        self.element(&format!("link '{}' collision {i}", l.name), &c.name, &c.origin, &c.geometry)
+                        self.element(
+                            &format!("link '{}' collision {i}", l.name),
+                            &c.name,
+                            &c.origin,
+                            &c.geometry,
+                        )
                     })
                     .collect::<Result<_>>()?,
             });
@@ -297,12 +313,18 @@ impl Builder {
             .map(|&l| {
                 let j = &robot.joints[parent_joint[l].unwrap_or_default()];
                 j.mimic.as_ref().map(|m| {
-                    (m.joint.clone(), m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0))
+                    (
+                        m.joint.clone(),
+                        m.multiplier.unwrap_or(1.0),
+                        m.offset.unwrap_or(0.0),
+                    )
                 })
             })
             .collect();
         for j in 0..joints.len() {
-            let Some((name, mult, off)) = declared[j].clone() else { continue };
+            let Some((name, mult, off)) = declared[j].clone() else {
+                continue;
+            };
             let mimic_err = |message: String| BodyError::Mimic {
                 file: self.file.clone(),
                 joint: joints[j].name.clone(),
@@ -344,7 +366,12 @@ impl Builder {
                 master_offset: m_off,
             });
         }
-        Ok(RobotModel::assemble(robot.name, self.file.clone(), links, joints))
+        Ok(RobotModel::assemble(
+            robot.name,
+            self.file.clone(),
+            links,
+            joints,
+        ))
     }
 
     fn inertial(&self, l: &urdf_rs::Link) -> Result<Inertial> {
@@ -360,7 +387,9 @@ impl Builder {
         Ok(Inertial {
             mass: i.mass.value,
             origin,
-            inertia: Matrix3::new(t.ixx, t.ixy, t.ixz, t.ixy, t.iyy, t.iyz, t.ixz, t.iyz, t.izz),
+            inertia: Matrix3::new(
+                t.ixx, t.ixy, t.ixz, t.ixy, t.iyy, t.iyz, t.ixz, t.iyz, t.izz,
+            ),
         })
     }
 
@@ -376,7 +405,10 @@ impl Builder {
             if v.is_finite() && v > 0.0 {
                 Ok(v)
             } else {
-                Err(self.invalid(format!("{el} {what}"), format!("{v} must be finite and > 0")))
+                Err(self.invalid(
+                    format!("{el} {what}"),
+                    format!("{v} must be finite and > 0"),
+                ))
             }
         };
         let geometry = match geometry {
@@ -395,7 +427,10 @@ impl Builder {
                 radius: positive("capsule radius", *radius)?,
                 length: {
                     if !(length.is_finite() && *length >= 0.0) {
-                        return Err(self.invalid(format!("{el} capsule length"), format!("{length} must be finite and >= 0")));
+                        return Err(self.invalid(
+                            format!("{el} capsule length"),
+                            format!("{length} must be finite and >= 0"),
+                        ));
                     }
                     *length
                 },
@@ -414,7 +449,10 @@ impl Builder {
                         mesh: path,
                     });
                 }
-                let key = (path.clone(), [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()]);
+                let key = (
+                    path.clone(),
+                    [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()],
+                );
                 let mesh = match self.meshes.get(&key) {
                     Some(m) => m.clone(),
                     None => {
@@ -473,7 +511,11 @@ impl Builder {
         self.finite(&format!("{el} axis"), &j.axis.xyz.0)?;
         let axis_v = Vector3::new(j.axis.xyz[0], j.axis.xyz[1], j.axis.xyz[2]);
         let axis = if kind == JointKind::Fixed {
-            Unit::new_normalize(if axis_v.norm() > 0.0 { axis_v } else { Vector3::x() })
+            Unit::new_normalize(if axis_v.norm() > 0.0 {
+                axis_v
+            } else {
+                Vector3::x()
+            })
         } else {
             Unit::try_new(axis_v, 1e-12)
                 .ok_or_else(|| self.invalid(format!("{el} axis"), "the axis is zero"))?

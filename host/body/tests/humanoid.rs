@@ -12,14 +12,31 @@ fn naming_contract_and_dimensions() {
     let m = common::humanoid();
     assert_eq!(m.links[0].name, "base_link");
     let names = [
-        "squat_z", "waist_yaw", "waist_pitch", "head_yaw", "head_pitch", "camera_joint",
-        "r_shoulder_pitch", "r_shoulder_roll", "r_shoulder_yaw", "r_elbow", "r_wrist_yaw",
-        "r_wrist_pitch", "r_wrist_roll",
+        "squat_z",
+        "waist_yaw",
+        "waist_pitch",
+        "head_yaw",
+        "head_pitch",
+        "camera_joint",
+        "r_shoulder_pitch",
+        "r_shoulder_roll",
+        "r_shoulder_yaw",
+        "r_elbow",
+        "r_wrist_yaw",
+        "r_wrist_pitch",
+        "r_wrist_roll",
     ];
     for n in names {
         m.joint_id(n).unwrap_or_else(|_| panic!("joint {n}"));
     }
-    for l in ["pelvis", "waist_link", "chest", "camera_link", "r_palm", "r_shoulder_link"] {
+    for l in [
+        "pelvis",
+        "waist_link",
+        "chest",
+        "camera_link",
+        "r_palm",
+        "r_shoulder_link",
+    ] {
         m.link_id(l).unwrap_or_else(|_| panic!("link {l}"));
     }
     let squat = &m.joints[m.joint_id("squat_z").unwrap()];
@@ -47,9 +64,20 @@ fn naming_contract_and_dimensions() {
     assert_eq!(j5.mimic.as_ref().unwrap().joint_name, "r_thumb_j4");
     // Every finger link has a collision shape, every finger joint an effort limit.
     for (j, joint) in m.joints.iter().enumerate() {
-        if ["r_thumb_j", "r_index_j", "r_middle_j", "r_ring_j"].iter().any(|p| joint.name.starts_with(p)) {
-            assert!(!m.links[j + 1].collisions.is_empty(), "{}", m.links[j + 1].name);
-            assert!(joint.limits.effort > 0.0 && joint.limits.effort <= 5.0, "{}", joint.name);
+        if ["r_thumb_j", "r_index_j", "r_middle_j", "r_ring_j"]
+            .iter()
+            .any(|p| joint.name.starts_with(p))
+        {
+            assert!(
+                !m.links[j + 1].collisions.is_empty(),
+                "{}",
+                m.links[j + 1].name
+            );
+            assert!(
+                joint.limits.effort > 0.0 && joint.limits.effort <= 5.0,
+                "{}",
+                joint.name
+            );
         }
     }
 
@@ -58,13 +86,20 @@ fn naming_contract_and_dimensions() {
     let z = |fk: &FkState, l: &str| fk.pose(m.link_id(l).unwrap()).translation.vector.z;
     assert!((z(&fk, "pelvis") - 0.85).abs() < 1e-12);
     let shoulder = z(&fk, "r_shoulder_link");
-    assert!((1.35..=1.40).contains(&shoulder), "shoulder height {shoulder}");
+    assert!(
+        (1.35..=1.40).contains(&shoulder),
+        "shoulder height {shoulder}"
+    );
     // Squatting lowers the shoulder by the joint value.
     let q = m.positions_from_named([("squat_z", -0.4)]).unwrap();
     m.forward_kinematics(&q, &mut fk);
     assert!((z(&fk, "r_shoulder_link") - (shoulder - 0.4)).abs() < 1e-12);
     // Total height about 1.6 m and mass about HRP-3P's 65 kg.
-    assert!((55.0..=75.0).contains(&m.total_mass()), "{}", m.total_mass());
+    assert!(
+        (55.0..=75.0).contains(&m.total_mass()),
+        "{}",
+        m.total_mass()
+    );
 }
 
 #[test]
@@ -83,7 +118,12 @@ fn palm_frame_convention() {
     let palm_inv = palm.inverse();
     let thumb = palm_inv * fk.pose(m.link_id("r_thumb_l2").unwrap()).translation.vector;
     assert!(thumb.y < -0.04, "{thumb:?}");
-    let tip = palm_inv * Point3::from(fk.pose(m.link_id("r_middle_l4").unwrap()).translation.vector);
+    let tip = palm_inv
+        * Point3::from(
+            fk.pose(m.link_id("r_middle_l4").unwrap())
+                .translation
+                .vector,
+        );
     assert!(tip.x > 0.1, "{tip:?}");
     // Flexing j2 moves the finger toward +z of the palm.
     let q = m.positions_from_named([("r_index_j2", 0.8)]).unwrap();
@@ -112,7 +152,12 @@ fn rest_pose_is_free_of_self_collision() {
     assert!(hits.is_empty(), "{hits:?}");
     // An arm swung into the chest is detected.
     let q = m
-        .positions_from_named([("r_shoulder_roll", 0.25), ("r_shoulder_pitch", -1.3), ("r_elbow", -2.3), ("r_shoulder_yaw", 1.5)])
+        .positions_from_named([
+            ("r_shoulder_roll", 0.25),
+            ("r_shoulder_pitch", -1.3),
+            ("r_elbow", -2.3),
+            ("r_shoulder_yaw", 1.5),
+        ])
         .unwrap();
     m.forward_kinematics(&q, &mut fk);
     assert!(c.first_self_collision(&fk, 0.0).is_some());

@@ -55,7 +55,10 @@ fn arm_reaches_random_reachable_targets() {
             }
         }
     }
-    eprintln!("arm IK: {ok}/{n} solved, mean {} iterations", iterations / n);
+    eprintln!(
+        "arm IK: {ok}/{n} solved, mean {} iterations",
+        iterations / n
+    );
     assert!(ok as f64 >= 0.99 * n as f64, "only {ok}/{n} solved");
 }
 

@@ -8,8 +8,8 @@ mod common;
 
 #[test]
 fn exact_agrees_with_ferrari_canny_and_the_inner_ellipsoid_never_lies() {
-    // 2 × 600 grasps of 3–6 contacts; ε_L∞ for the 3-contact ones.
-    let s = common::sweep(600, 0x75_6b_61_6d_69, &[3, 4, 5, 6], 8, 3);
+    // 2 × 400 grasps of 3–6 contacts; ε_L∞ for 2 × 8 grasps of 3 contacts.
+    let s = common::sweep(400, 0x75_6b_61_6d_69, &[3, 4, 5, 6], 8, 8);
     println!("exact(8-pyramid) vs eps_L1 > 0: {}", s.exact_vs_l1);
     println!("exact(8-pyramid) vs eps_Linf > 0: {}", s.exact_vs_linf);
     println!("ellipsoid closure, delta_f = 0: {}", s.ellipsoid_closure);
@@ -21,9 +21,10 @@ fn exact_agrees_with_ferrari_canny_and_the_inner_ellipsoid_never_lies() {
 
     // Same cone model, same answer (up to boundary cases of measure zero).
     assert!(s.exact_vs_l1.agreement() >= 0.999, "{}", s.exact_vs_l1);
+    assert_eq!(s.exact_vs_linf.total(), 16);
     assert!(s.exact_vs_linf.agreement() >= 0.999, "{}", s.exact_vs_linf);
     // The set must exercise both answers.
-    assert!(s.exact_vs_l1.true_pos > 100 && s.exact_vs_l1.true_neg > 100, "{}", s.exact_vs_l1);
+    assert!(s.exact_vs_l1.true_pos > 80 && s.exact_vs_l1.true_neg > 80, "{}", s.exact_vs_l1);
     // The inscribed pyramid is inside the cone: it can only lose closure.
     assert_eq!(s.poly_vs_circular.false_pos, 0, "{}", s.poly_vs_circular);
     // With threshold 1 (δf = n − 1) eq. (10) is an inner approximation of the

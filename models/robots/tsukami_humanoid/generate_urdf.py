@@ -152,7 +152,7 @@ link("camera_link", 0.0, [])
 
 # ---- left arm: a fixed stub ----
 joint("l_arm_fixed", "fixed", "chest", "l_arm_stub", [0, 0.21, 0.43])
-link("l_arm_stub", 5.0, [(("capsule", 0.045, 0.46), [0, 0, -0.275], [0, 0, 0])], "grey")
+link("l_arm_stub", 5.0, [(("capsule", 0.045, 0.52), [0, 0, -0.305], [0, 0, 0])], "grey")
 
 # ---- right arm, 7 DOF ----
 joint("r_shoulder_pitch", "revolute", "chest", "r_shoulder_link", [0, -0.21, 0.43], axis=(0, 1, 0), limit=(-3.0, 1.0, 150, 3.0))
@@ -160,13 +160,13 @@ link("r_shoulder_link", 2.5, [(("sphere", 0.055), [0, 0, 0], [0, 0, 0])])
 joint("r_shoulder_roll", "revolute", "r_shoulder_link", "r_shoulder_roll_link", [0, 0, 0], axis=(1, 0, 0), limit=(-1.8, 0.25, 150, 3.0))
 link("r_shoulder_roll_link", 0.5, [])
 joint("r_shoulder_yaw", "revolute", "r_shoulder_roll_link", "r_upper_arm_link", [0, 0, 0], axis=(0, 0, 1), limit=(-1.7, 1.7, 100, 3.0))
-link("r_upper_arm_link", 2.0, [(("capsule", 0.045, 0.18), [0, 0, -0.135], [0, 0, 0])])
-joint("r_elbow", "revolute", "r_upper_arm_link", "r_forearm_link", [0, 0, -0.27], axis=(0, 1, 0), limit=(-2.6, 0.0, 100, 3.0))
+link("r_upper_arm_link", 2.0, [(("capsule", 0.045, 0.21), [0, 0, -0.15], [0, 0, 0])])
+joint("r_elbow", "revolute", "r_upper_arm_link", "r_forearm_link", [0, 0, -0.30], axis=(0, 1, 0), limit=(-2.6, 0.0, 100, 3.0))
 link("r_forearm_link", 1.2, [(("capsule", 0.04, 0.08), [0, 0, -0.06], [0, 0, 0])])
 joint("r_wrist_yaw", "revolute", "r_forearm_link", "r_wrist_yaw_link", [0, 0, -0.12], axis=(0, 0, 1), limit=(-2.0, 2.0, 40, 3.5))
-link("r_wrist_yaw_link", 0.8, [(("capsule", 0.036, 0.06), [0, 0, -0.06], [0, 0, 0])])
+link("r_wrist_yaw_link", 0.8, [(("capsule", 0.036, 0.07), [0, 0, -0.065], [0, 0, 0])])
 # Flexion (toward the palm, +y at zero) about x; deviation about y.
-joint("r_wrist_pitch", "revolute", "r_wrist_yaw_link", "r_wrist_pitch_link", [0, 0, -0.13], axis=(1, 0, 0), limit=(-1.4, 1.4, 30, 3.5))
+joint("r_wrist_pitch", "revolute", "r_wrist_yaw_link", "r_wrist_pitch_link", [0, 0, -0.14], axis=(1, 0, 0), limit=(-1.4, 1.4, 30, 3.5))
 link("r_wrist_pitch_link", 0.2, [])
 joint("r_wrist_roll", "revolute", "r_wrist_pitch_link", "r_wrist_roll_link", [0, 0, 0], axis=(0, 1, 0), limit=(-1.0, 1.0, 30, 3.5))
 link("r_wrist_roll_link", 0.2, [])

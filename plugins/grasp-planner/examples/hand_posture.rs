@@ -23,14 +23,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let palm = robot.link_id("r_palm")?;
     let inv = fk.pose(palm).inverse();
     for (i, link) in robot.links.iter().enumerate() {
-        if !link.name.contains("_l") || !(link.name.starts_with("r_thumb") || link.name.starts_with("r_index") || link.name.starts_with("r_middle") || link.name.starts_with("r_ring")) {
+        if !link.name.contains("_l")
+            || !(link.name.starts_with("r_thumb")
+                || link.name.starts_with("r_index")
+                || link.name.starts_with("r_middle")
+                || link.name.starts_with("r_ring"))
+        {
             continue;
         }
         let p0 = inv * fk.pose(i) * Point3::origin();
         // Capsules run along x from the joint to the link's tip.
-        let len = link.collisions.first().map_or(0.0, |c| 2.0 * c.origin.translation.x);
+        let len = link
+            .collisions
+            .first()
+            .map_or(0.0, |c| 2.0 * c.origin.translation.x);
         let tip = inv * fk.pose(i) * Point3::new(len, 0.0, 0.0);
-        println!("{:12} base [{:7.3} {:7.3} {:7.3}]  tip [{:7.3} {:7.3} {:7.3}]", link.name, p0.x, p0.y, p0.z, tip.x, tip.y, tip.z);
+        println!(
+            "{:12} base [{:7.3} {:7.3} {:7.3}]  tip [{:7.3} {:7.3} {:7.3}]",
+            link.name, p0.x, p0.y, p0.z, tip.x, tip.y, tip.z
+        );
     }
     Ok(())
 }

@@ -73,7 +73,8 @@ fn distance_at(
     q[c.joint] = angle;
     hand.robot.apply_mimics(q);
     hand.robot.forward_kinematics(q, fk);
-    hand.collision.link_object_proximity(fk, c.link, object, 0.2)
+    hand.collision
+        .link_object_proximity(fk, c.link, object, 0.2)
 }
 
 fn close_one(
@@ -151,7 +152,9 @@ fn finger_force(
     let j = Matrix3xX::from_fn(sel.len(), |r, k| j6[(r, k)]);
     let efforts = DVector::from_iterator(
         sel.len(),
-        sel.joints.iter().map(|&jid| hand.robot.joints[jid].limits.effort),
+        sel.joints
+            .iter()
+            .map(|&jid| hand.robot.joints[jid].limits.effort),
     );
     match max_finger_force(&j, &efforts, normal) {
         Ok(f) => f.force.min(MAX_FINGER_FORCE),

@@ -121,6 +121,11 @@ pub struct GraspType {
     pub posture: BTreeMap<String, f64>,
     /// Contacting links and the joint closing each.
     pub contacts: Vec<ContactSpec>,
+    /// Links that may touch the object without being contacts of the force
+    /// analysis (e.g. the middle phalanges wrapping an object in an envelope
+    /// grasp); default none.
+    #[serde(default)]
+    pub touch_allowed: Vec<String>,
     /// GRCmax: largest box that fits without touching the fingers.
     pub grc_max: GrcBox,
     /// GRCmin: smallest object the posture can hold.
@@ -341,6 +346,11 @@ impl GraspTypeConfig {
                     .joint_id(j)
                     .map_err(|_| missing(&g.name, "posture", "joint", j))?;
             }
+            for l in &g.touch_allowed {
+                robot
+                    .link_id(l)
+                    .map_err(|_| missing(&g.name, "touch_allowed", "link", l))?;
+            }
             for c in &g.contacts {
                 robot
                     .link_id(&c.link)
@@ -360,7 +370,7 @@ impl GraspTypeConfig {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     pub(crate) const MINIMAL: &str = r#"

@@ -110,9 +110,21 @@ impl HandModel {
         let id = |n: &str| robot.joint_id(n);
         let h = &config.hand;
         let palm = robot.link_id(&h.palm_link)?;
-        let arm = h.arm_joints.iter().map(|n| id(n)).collect::<Result<Vec<_>, _>>()?;
-        let wrist = h.wrist_joints.iter().map(|n| id(n)).collect::<Result<Vec<_>, _>>()?;
-        let waist = h.waist_joints.iter().map(|n| id(n)).collect::<Result<Vec<_>, _>>()?;
+        let arm = h
+            .arm_joints
+            .iter()
+            .map(|n| id(n))
+            .collect::<Result<Vec<_>, _>>()?;
+        let wrist = h
+            .wrist_joints
+            .iter()
+            .map(|n| id(n))
+            .collect::<Result<Vec<_>, _>>()?;
+        let waist = h
+            .waist_joints
+            .iter()
+            .map(|n| id(n))
+            .collect::<Result<Vec<_>, _>>()?;
         let squat = h.squat_joint.as_deref().map(id).transpose()?;
         let below = |root: LinkId| -> Vec<LinkId> {
             let mut out = vec![root];
@@ -143,6 +155,15 @@ impl HandModel {
                     && !collision.link_parts(*l).is_empty()
             })
             .collect();
+        // Torso, head and legs move only through the waist and squat joints,
+        // whose limits are the robot's business: only pairs involving the arm
+        // or the hand are checked for self-collision.
+        let mut collision = collision;
+        for (i, &a) in body_links.iter().enumerate() {
+            for &b in &body_links[i + 1..] {
+                collision.allow(a, b);
+            }
+        }
         let mut types = Vec::new();
         for g in &config.grasp_types {
             let posture = g
@@ -161,7 +182,11 @@ impl HandModel {
                 contacts.push(ResolvedContact {
                     link,
                     joint: id(&c.joint)?,
-                    perturb: c.perturb.iter().map(|n| id(n)).collect::<Result<Vec<_>, _>>()?,
+                    perturb: c
+                        .perturb
+                        .iter()
+                        .map(|n| id(n))
+                        .collect::<Result<Vec<_>, _>>()?,
                     finger_joints,
                 });
             }
@@ -187,7 +212,10 @@ impl HandModel {
 
     /// Names of joints.
     pub fn names(&self, joints: &[JointId]) -> Vec<String> {
-        joints.iter().map(|&j| self.robot.joints[j].name.clone()).collect()
+        joints
+            .iter()
+            .map(|&j| self.robot.joints[j].name.clone())
+            .collect()
     }
 
     /// Sets the hand joints of `q` to the reference posture of grasp type `t`

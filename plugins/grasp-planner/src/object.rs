@@ -57,7 +57,9 @@ pub enum ObjectError {
         detail: String,
     },
     /// The object is too large or too small to be grasped by a hand.
-    #[error("object `{name}`: size {diagonal:.3} m (bounding-box diagonal) is outside [{min}, {max}] m")]
+    #[error(
+        "object `{name}`: size {diagonal:.3} m (bounding-box diagonal) is outside [{min}, {max}] m"
+    )]
     Size {
         /// Object name.
         name: String,
@@ -131,7 +133,10 @@ impl PlanObject {
         let t = pose.translation.vector;
         let q = pose.rotation.coords;
         if !t.iter().chain(q.iter()).all(|x| x.is_finite()) {
-            return Err(field("pose", "position and quaternion must be finite (got NaN or infinity)".into()));
+            return Err(field(
+                "pose",
+                "position and quaternion must be finite (got NaN or infinity)".into(),
+            ));
         }
         check_mesh(name, mesh)?;
         let com_local = match center_of_mass {
@@ -237,7 +242,8 @@ mod tests {
     fn can_is_accepted_with_com_at_its_centre() {
         let mesh = TriangleMesh::cylinder(0.033, 0.122, 24);
         let pose = Isometry3::translation(0.5, -0.2, 1.0);
-        let o = PlanObject::new("can", &mesh, pose, 0.15, 0.5, None, &OcpParams::default()).unwrap();
+        let o =
+            PlanObject::new("can", &mesh, pose, 0.15, 0.5, None, &OcpParams::default()).unwrap();
         let (lo, hi) = mesh.aabb();
         let centre = pose * Point3::from((lo.coords + hi.coords) / 2.0);
         assert!((o.center_of_mass - centre).norm() < 1e-9);

@@ -55,7 +55,12 @@ pub fn palm_targets(g: &GraspType, ocp: &Ocp, face: BoxFace) -> Vec<PalmTarget> 
     let depth = ocp.extents[k];
     let shift = ((depth - des_p[ka]) * 0.5).max(0.0);
     let target = ocp.center + n * shift;
-    let orders = [(u, v, eu, ev), (v, -u, ev, eu), (-u, -v, eu, ev), (-v, u, ev, eu)];
+    let orders = [
+        (u, v, eu, ev),
+        (v, -u, ev, eu),
+        (-u, -v, eu, ev),
+        (-v, u, ev, eu),
+    ];
     let mut out = Vec::new();
     for (r, (d1, _d2, e1, e2)) in orders.into_iter().enumerate() {
         // Containment: GRCmax holds the face, GRCmin fits on it.
@@ -81,7 +86,12 @@ pub fn palm_targets(g: &GraspType, ocp: &Ocp, face: BoxFace) -> Vec<PalmTarget> 
 }
 
 /// The palm-pose criterion for joint positions `q` (smaller is better).
-pub fn criterion_value(hand: &HandModel, q: &[f64], criterion: PalmCriterion, joints: &[JointId]) -> f64 {
+pub fn criterion_value(
+    hand: &HandModel,
+    q: &[f64],
+    criterion: PalmCriterion,
+    joints: &[JointId],
+) -> f64 {
     match criterion {
         // Section 3.2: "the minimum norm of joint angles of the wrist".
         PalmCriterion::MinWristNorm => hand.wrist.iter().map(|&j| q[j] * q[j]).sum::<f64>().sqrt(),
@@ -108,12 +118,10 @@ mod tests {
 
     #[test]
     fn approach_points_into_the_face_and_rotations_are_filtered() {
-        let cfg = GraspTypeConfig::from_toml_str(
-            &crate::grasp_type::tests::MINIMAL.replace(
-                "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.02, 0.02] }",
-                "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.09, 0.02] }",
-            ),
-        )
+        let cfg = GraspTypeConfig::from_toml_str(&crate::grasp_type::tests::MINIMAL.replace(
+            "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.02, 0.02] }",
+            "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.09, 0.02] }",
+        ))
         .unwrap();
         let g = &cfg.grasp_types[0];
         // A can standing at (0.5, 0, 1.061); axis 0 vertical.

@@ -166,7 +166,9 @@ pub fn search(
         return Outcome::Exhausted;
     };
     // In the squat stage, Δp_s fixes the squat joint and IK uses the rest.
-    let squat = (stage.stage == Stage::Squat).then_some(hand.squat).flatten();
+    let squat = (stage.stage == Stage::Squat)
+        .then_some(hand.squat)
+        .flatten();
     let mut ik_no_squat = squat.and_then(|s| {
         let joints: Vec<_> = stage.joints.iter().copied().filter(|&j| j != s).collect();
         let sel = JointSelection::new(robot, &joints).ok()?;
@@ -181,6 +183,7 @@ pub fn search(
         .hand
         .touch_allowed
         .iter()
+        .chain(g.touch_allowed.iter())
         .filter_map(|n| robot.link_id(n).ok())
         .collect();
     let moving: Vec<LinkId> = hand
@@ -254,7 +257,10 @@ pub fn search(
             robot.apply_mimics(&mut q);
         }
         robot.forward_kinematics(&q, &mut fk);
-        if hand.collision.first_collision(&fk, &moving, ctx.env, 0.0).is_some()
+        if hand
+            .collision
+            .first_collision(&fk, &moving, ctx.env, 0.0)
+            .is_some()
             || hand
                 .collision
                 .first_collision(&fk, &not_touching, &[object], 0.0)
@@ -275,7 +281,10 @@ pub fn search(
             counters.rejections[2] += 1;
             continue;
         };
-        if hand.collision.first_collision(&fk, &moving, ctx.env, 0.0).is_some()
+        if hand
+            .collision
+            .first_collision(&fk, &moving, ctx.env, 0.0)
+            .is_some()
             || hand
                 .collision
                 .first_collision(&fk, &not_touching, &[object], 0.0)
@@ -320,7 +329,13 @@ pub fn make_grasp(object: &PlanObject, contacts: &[FingerContact]) -> Option<Gra
         .iter()
         .map(|c| Contact::new(c.position, c.normal).ok())
         .collect::<Option<Vec<_>>>()?;
-    let limits = contacts.iter().map(|c| c.f_max.max(1e-6)).collect();
+    // The paper's single "maximum finger force" of the hand: the weakest finger's.
+    let f_hand = contacts
+        .iter()
+        .map(|c| c.f_max)
+        .fold(f64::INFINITY, f64::min)
+        .max(1e-6);
+    let limits = vec![f_hand; contacts.len()];
     Grasp::with_force_limits(
         cs,
         limits,

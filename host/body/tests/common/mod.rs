@@ -27,7 +27,10 @@ pub fn random_q(model: &RobotModel, rng: &mut ChaCha8Rng) -> Vec<f64> {
     let mut q = vec![0.0; model.joints.len()];
     for (j, joint) in model.joints.iter().enumerate() {
         if joint.is_independent() {
-            let (lo, hi) = (joint.limits.lower.max(-3.14), joint.limits.upper.min(3.14));
+            let (lo, hi) = (
+                joint.limits.lower.max(-std::f64::consts::PI),
+                joint.limits.upper.min(std::f64::consts::PI),
+            );
             q[j] = rng.random_range(lo..=hi);
         }
     }

@@ -1,6 +1,9 @@
 //! Command-line interface (clap derive): the host, the bus client, the demo, and the
 //! offline tools.
 
+mod fc;
+mod model;
+
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use std::io::Read;
@@ -110,6 +113,13 @@ enum Command {
     },
     /// Run the main job: start a private host with its plugins and show it working.
     Demo(tsukami::demo::DemoArgs),
+    /// Robot models: inspect, forward and inverse kinematics.
+    Model {
+        #[command(subcommand)]
+        command: model::ModelCommand,
+    },
+    /// Force-closure tests and grasp quality of contact sets (JSON in, JSON out).
+    Fc(fc::FcArgs),
 }
 
 /// Runs the CLI and maps errors to a message and exit status 1.
@@ -150,6 +160,8 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Stop => send(&cli.bus, ROLE_GRASP_PLANNER, keys::STOP, b""),
         Command::Schema { out } => write_schema(out),
         Command::Demo(args) => tsukami::demo::run(args),
+        Command::Model { command } => model::run(command).map(|()| ExitCode::SUCCESS),
+        Command::Fc(args) => fc::run(args).map(|()| ExitCode::SUCCESS),
     }
 }
 

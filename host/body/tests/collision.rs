@@ -1,0 +1,280 @@
+//! Distance queries: analytic cases (sphere–box, capsule–cylinder), a mesh
+//! against brute force, closed meshes as solids, obstacle checks.
+
+mod common;
+
+use nalgebra::{Isometry3, Point3, Vector3};
+use tsukami_body::collision::{CollisionObject, Part, RobotCollision};
+use tsukami_body::kinematics::FkState;
+use tsukami_body::mesh::TriangleMesh;
+use tsukami_body::model::Geometry;
+use tsukami_body::RobotModel;
+
+/// A one-link robot whose link carries `geometry` (URDF snippet).
+fn probe(geometry: &str) -> (RobotModel, RobotCollision, FkState) {
+    let xml = format!(
+        r#"<robot name="probe"><link name="probe"><collision><geometry>{geometry}</geometry></collision></link></robot>"#
+    );
+    let m = RobotModel::from_urdf_str(&xml, std::path::Path::new("/tmp")).unwrap();
+    let c = RobotCollision::new(&m).unwrap();
+    let fk = FkState::new(&m);
+    (m, c, fk)
+}
+
+fn place(m: &RobotModel, fk: &mut FkState, pose: Isometry3<f64>) {
+    fk.base = pose;
+    m.forward_kinematics(&[], fk);
+}
+
+fn object(geometry: Geometry, pose: Isometry3<f64>) -> CollisionObject {
+    CollisionObject::new(
+        "o",
+        pose,
+        vec![Part::from_geometry(&Isometry3::identity(), &geometry).unwrap()],
+    )
+}
+
+#[test]
+fn sphere_box() {
+    let (m, c, mut fk) = probe(r#"<sphere radius="0.1"/>"#);
+    let boxed = object(
+        Geometry::Box {
+            size: Vector3::new(0.4, 0.6, 0.2),
+        },
+        Isometry3::identity(),
+    );
+    place(&m, &mut fk, Isometry3::translation(0.5, 0.2, 0.05));
+    let p = c.link_object_proximity(&fk, 0, &boxed, 10.0).unwrap();
+    assert!((p.distance - 0.2).abs() < 1e-9, "{p:?}");
+    assert!((p.point_on_object - Point3::new(0.2, 0.2, 0.05)).norm() < 1e-9);
+    assert!((p.point_on_link - Point3::new(0.4, 0.2, 0.05)).norm() < 1e-9);
+    assert!((p.normal.into_inner() - Vector3::x()).norm() < 1e-9);
+    // Beyond max_distance: nothing.
+    assert!(c.link_object_proximity(&fk, 0, &boxed, 0.1).is_none());
+    // Overlapping by 0.03: negative distance, normal still out of the box.
+    place(&m, &mut fk, Isometry3::translation(0.27, 0.0, 0.0));
+    let p = c.link_object_proximity(&fk, 0, &boxed, 10.0).unwrap();
+    assert!((p.distance + 0.03).abs() < 1e-9, "{p:?}");
+    assert!((p.normal.into_inner() - Vector3::x()).norm() < 1e-9);
+    // A rotated box: the box frame is turned 90° about z.
+    let turned = object(
+        Geometry::Box {
+            size: Vector3::new(0.4, 0.6, 0.2),
+        },
+        Isometry3::new(Vector3::zeros(), Vector3::z() * std::f64::consts::FRAC_PI_2),
+    );
+    place(&m, &mut fk, Isometry3::translation(0.5, 0.0, 0.0));
+    let p = c.link_object_proximity(&fk, 0, &turned, 10.0).unwrap();
+    assert!((p.distance - 0.1).abs() < 1e-9, "{p:?}");
+}
+
+#[test]
+fn capsule_cylinder() {
+    // URDF capsule and cylinder are both along z.
+    let (m, c, mut fk) = probe(r#"<capsule radius="0.02" length="0.1"/>"#);
+    let cyl = object(
+        Geometry::Cylinder {
+            radius: 0.05,
+            length: 0.2,
+        },
+        Isometry3::identity(),
+    );
+    // Side by side, parallel: distance 0.3 - 0.05 - 0.02.
+    place(&m, &mut fk, Isometry3::translation(0.0, 0.3, 0.0));
+    let p = c.link_object_proximity(&fk, 0, &cyl, 10.0).unwrap();
+    assert!((p.distance - 0.23).abs() < 1e-6, "{p:?}");
+    assert!((p.point_on_object.y - 0.05).abs() < 1e-6 && p.point_on_object.z.abs() <= 0.05 + 1e-6);
+    assert!((p.point_on_link.y - 0.28).abs() < 1e-6);
+    assert!((p.normal.into_inner() - Vector3::y()).norm() < 1e-6);
+    // Lying across the top: capsule along x, 0.2 above the centre.
+    place(
+        &m,
+        &mut fk,
+        Isometry3::new(
+            Vector3::new(0.0, 0.0, 0.2),
+            Vector3::y() * std::f64::consts::FRAC_PI_2,
+        ),
+    );
+    let p = c.link_object_proximity(&fk, 0, &cyl, 10.0).unwrap();
+    assert!((p.distance - 0.08).abs() < 1e-6, "{p:?}");
+    assert!((p.point_on_object.z - 0.1).abs() < 1e-6);
+    assert!((p.normal.into_inner() - Vector3::z()).norm() < 1e-6);
+    // Off the rim, diagonally: the closest point is on the rim circle.
+    place(
+        &m,
+        &mut fk,
+        Isometry3::new(
+            Vector3::new(0.15, 0.0, 0.25),
+            Vector3::y() * std::f64::consts::FRAC_PI_2,
+        ),
+    );
+    let p = c.link_object_proximity(&fk, 0, &cyl, 10.0).unwrap();
+    // Capsule segment x in [0.1, 0.2] at z 0.25; rim point (0.05, 0, 0.1).
+    let expect = ((0.1f64 - 0.05).powi(2) + 0.15f64.powi(2)).sqrt() - 0.02;
+    assert!((p.distance - expect).abs() < 1e-7, "{p:?} vs {expect}");
+    assert!((p.point_on_object - Point3::new(0.05, 0.0, 0.1)).norm() < 1e-6);
+}
+
+/// Closest point on a triangle (Ericson, Real-Time Collision Detection 5.1.5).
+fn closest_on_triangle(
+    p: Point3<f64>,
+    a: Point3<f64>,
+    b: Point3<f64>,
+    c: Point3<f64>,
+) -> Point3<f64> {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    a + ab * (vb * denom) + ac * (vc * denom)
+}
+
+#[test]
+fn mesh_distance_matches_brute_force() {
+    let (m, c, mut fk) = probe(r#"<sphere radius="0.015"/>"#);
+    let can = TriangleMesh::load(
+        &common::models_dir().join("objects/can_350ml/can_350ml.stl"),
+        Vector3::repeat(1.0),
+    )
+    .unwrap();
+    let obj_pose = Isometry3::new(Vector3::new(0.4, -0.2, 0.8), Vector3::new(0.2, -0.1, 0.7));
+    let object = CollisionObject::from_mesh("can", obj_pose, &can).unwrap();
+    assert!(object.is_solid());
+    let mut rng = common::rng(5);
+    use rand::Rng;
+    let mut checked = 0;
+    for _ in 0..300 {
+        let local = Point3::new(
+            rng.random_range(-0.12..0.12),
+            rng.random_range(-0.12..0.12),
+            rng.random_range(-0.08..0.2),
+        );
+        let centre = obj_pose * local;
+        place(
+            &m,
+            &mut fk,
+            Isometry3::translation(centre.x, centre.y, centre.z),
+        );
+        // Brute force over every triangle, in the object frame.
+        let (mut best, mut best_pt) = (f64::INFINITY, Point3::origin());
+        for k in 0..can.indices.len() {
+            let [a, b, cc] = can.triangle(k);
+            let q = closest_on_triangle(local, a, b, cc);
+            let d = (q - local).norm();
+            if d < best {
+                best = d;
+                best_pt = q;
+            }
+        }
+        let inside = can.volume() > 0.0 && {
+            // Inside iff the vector to the closest point faces the same way as the outward normal there.
+            let k = (0..can.indices.len())
+                .min_by(|&i, &j| {
+                    let [a, b, cc] = can.triangle(i);
+                    let [d, e, f] = can.triangle(j);
+                    (closest_on_triangle(local, a, b, cc) - local)
+                        .norm()
+                        .total_cmp(&(closest_on_triangle(local, d, e, f) - local).norm())
+                })
+                .unwrap();
+            (best_pt - local).dot(&can.triangle_normal(k)) > 0.0
+        };
+        let Some(p) = c.link_object_proximity(&fk, 0, &object, 1.0) else {
+            panic!("no result")
+        };
+        if best > 0.02 {
+            let expect = if inside {
+                -(best + 0.015)
+            } else {
+                best - 0.015
+            };
+            // Inside: our distance is minus the link-to-surface distance.
+            let ours = p.distance;
+            if inside {
+                assert!(ours < 0.0, "inside point reported at {ours}");
+                assert!((ours + (best - 0.015)).abs() < 1e-6, "{ours} vs {expect}");
+            } else {
+                assert!((ours - expect).abs() < 1e-6, "{ours} vs {expect}");
+                assert!((p.point_on_object - obj_pose * best_pt).norm() < 1e-6);
+                // The normal points from the object toward the link.
+                assert!(
+                    (p.normal.into_inner() - (centre - p.point_on_object).normalize()).norm()
+                        < 1e-6
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 100, "{checked}");
+}
+
+#[test]
+fn closed_meshes_are_solids_open_ones_are_not() {
+    let (m, c, mut fk) = probe(r#"<sphere radius="0.01"/>"#);
+    let can = TriangleMesh::cylinder(0.033, 0.122, 32);
+    let solid = CollisionObject::from_mesh("can", Isometry3::identity(), &can).unwrap();
+    place(&m, &mut fk, Isometry3::translation(0.0, 0.0, 0.06));
+    let p = c.link_object_proximity(&fk, 0, &solid, 1.0).unwrap();
+    assert!(p.distance < 0.0, "{p:?}");
+    assert!(c.first_collision(&fk, &[0], &[&solid], 0.0).is_some());
+    // The same mesh without its caps is open: a surface only.
+    let mut open = can.clone();
+    open.indices.truncate(64);
+    assert!(!open.is_closed());
+    let surface = CollisionObject::from_mesh("tube", Isometry3::identity(), &open).unwrap();
+    assert!(!surface.is_solid());
+    assert!(c.first_collision(&fk, &[0], &[&surface], 0.0).is_none());
+    // Margins: 5 mm from the side is clear at margin 0 but not at 1 cm.
+    place(&m, &mut fk, Isometry3::translation(0.048, 0.0, 0.06));
+    assert!(c.first_collision(&fk, &[0], &[&solid], 0.0).is_none());
+    assert!(c.first_collision(&fk, &[0], &[&solid], 0.01).is_some());
+}
+
+#[test]
+fn hand_links_against_a_can() {
+    let m = common::humanoid();
+    let c = RobotCollision::new(&m).unwrap();
+    let mut fk = FkState::new(&m);
+    m.forward_kinematics(&m.rest_positions(), &mut fk);
+    let tip = m.link_id("r_index_l4").unwrap();
+    let can = TriangleMesh::load(
+        &common::models_dir().join("objects/can_350ml/can_350ml.stl"),
+        Vector3::repeat(1.0),
+    )
+    .unwrap();
+    // Put the can 2 cm in front of the fingertip along the palm normal.
+    let palm = fk.pose(m.link_id("r_palm").unwrap());
+    let tip_pose = fk.pose(tip);
+    let centre =
+        tip_pose.translation.vector + palm.rotation * Vector3::z() * (0.0085 + 0.02 + 0.033);
+    let pose = Isometry3::translation(centre.x, centre.y, centre.z - 0.061);
+    let obj = CollisionObject::from_mesh("can", pose, &can).unwrap();
+    let p = c.link_object_proximity(&fk, tip, &obj, 1.0).unwrap();
+    assert!((p.distance - 0.02).abs() < 2e-3, "{p:?}");
+    // Normal on the can's side points back toward the finger (-palm z).
+    assert!(p.normal.dot(&(palm.rotation * -Vector3::z())) > 0.95);
+}

@@ -1,0 +1,291 @@
+//! Bad requests get clear errors and never lose the state already set;
+//! cancellation and progress reporting.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use nalgebra::Vector3;
+use tsukami_body::mesh::TriangleMesh;
+use tsukami_grasp_planner::planner::{PlanError, Planner};
+use tsukami_grasp_planner::scene::scene_requests;
+use tsukami_msgs::planner::{
+    ObjectShape, Obstacle, ObstacleShape, PlanOptions, PlanPhase, Pose, RemoveEnv, SetEnv,
+    SetObject, SetRobot,
+};
+
+fn models() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tsukami-planner-tests-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn ready() -> Planner {
+    let req = scene_requests(&models().join("scenes/can_breast.toml")).unwrap();
+    let mut p = Planner::new(models());
+    p.set_robot(&req.robot).unwrap();
+    p.set_object(&req.object).unwrap();
+    p.set_env(&req.env).unwrap();
+    p
+}
+
+fn mesh_object(path: &Path, mass: f64) -> SetObject {
+    SetObject {
+        name: None,
+        shape: ObjectShape::Mesh {
+            path: path.display().to_string(),
+            scale: None,
+        },
+        mass,
+        friction: None,
+        pose: Pose::at([0.5, -0.25, 1.1]),
+        center_of_mass: None,
+    }
+}
+
+fn plan(p: &mut Planner) -> Result<tsukami_msgs::planner::PlanReply, PlanError> {
+    p.plan(
+        &PlanOptions::default(),
+        &AtomicBool::new(false),
+        &mut |_| {},
+    )
+}
+
+#[test]
+fn plan_without_robot_or_object_says_so() {
+    let mut p = Planner::new(models());
+    assert!(matches!(plan(&mut p), Err(PlanError::NoRobot)));
+    p.set_robot(&SetRobot {
+        robot: "tsukami_humanoid".into(),
+        grasp_types: None,
+    })
+    .unwrap();
+    let e = plan(&mut p).unwrap_err();
+    assert!(matches!(e, PlanError::NoObject));
+    assert_eq!(e.code(), "no_object");
+    assert!(e.to_string().contains("set_object"));
+}
+
+#[test]
+fn bad_objects_are_refused_and_the_state_is_kept() {
+    let mut p = ready();
+    let before = p.object().unwrap().name.clone();
+    let can = TriangleMesh::cylinder(0.033, 0.122, 24);
+
+    // Unknown model name.
+    let e = p
+        .set_object(&SetObject {
+            shape: ObjectShape::Model {
+                name: "no_such_thing".into(),
+            },
+            ..mesh_object(Path::new("x"), 0.1)
+        })
+        .unwrap_err();
+    assert_eq!(e.code(), "unknown_model");
+    assert!(e.to_string().contains("no_such_thing"), "{e}");
+
+    // Mass <= 0.
+    let good = tmp("can.stl");
+    can.write_stl(&good).unwrap();
+    for m in [0.0, -1.0, f64::NAN] {
+        let e = p.set_object(&mesh_object(&good, m)).unwrap_err();
+        assert!(e.to_string().contains("mass"), "{e}");
+    }
+
+    // NaN pose.
+    let mut req = mesh_object(&good, 0.1);
+    req.pose.position[1] = f64::NAN;
+    let e = p.set_object(&req).unwrap_err();
+    assert!(e.to_string().contains("pose"), "{e}");
+
+    // Open mesh.
+    let mut open = can.clone();
+    open.indices.truncate(open.indices.len() - 3);
+    let path = tmp("open.stl");
+    open.write_stl(&path).unwrap();
+    let e = p.set_object(&mesh_object(&path, 0.1)).unwrap_err();
+    assert!(e.to_string().contains("open"), "{e}");
+
+    // Degenerate: a flat, closed, two-sided sheet encloses no volume.
+    let mut flat = TriangleMesh::cuboid(Vector3::new(0.1, 0.1, 0.05));
+    for v in &mut flat.vertices {
+        v.z = 0.0;
+    }
+    let path = tmp("flat.obj");
+    flat.write_obj(&path).unwrap();
+    let e = p.set_object(&mesh_object(&path, 0.1)).unwrap_err();
+    assert_eq!(e.code(), "bad_object");
+    assert!(e.to_string().contains("degenerate"), "{e}");
+
+    // Huge: one million triangles.
+    let path = tmp("huge.stl");
+    {
+        use std::io::Write;
+        let n: u32 = 1_000_000;
+        let mut f = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+        f.write_all(&[0u8; 80]).unwrap();
+        f.write_all(&n.to_le_bytes()).unwrap();
+        let mut tri = [0u8; 50];
+        for i in 0..n {
+            let x = (i % 1000) as f32 * 1e-4;
+            let y = (i / 1000) as f32 * 1e-4;
+            for (k, v) in [x, y, 0.0, x + 1e-4, y, 0.0, x, y + 1e-4, 0.0]
+                .iter()
+                .enumerate()
+            {
+                tri[12 + 4 * k..16 + 4 * k].copy_from_slice(&v.to_le_bytes());
+            }
+            f.write_all(&tri).unwrap();
+        }
+    }
+    let e = p.set_object(&mesh_object(&path, 0.1)).unwrap_err();
+    assert!(e.to_string().contains("huge"), "{e}");
+    std::fs::remove_file(&path).unwrap();
+
+    // Missing file.
+    let e = p
+        .set_object(&mesh_object(Path::new("/nonexistent/x.stl"), 0.1))
+        .unwrap_err();
+    assert!(e.to_string().contains("/nonexistent/x.stl"), "{e}");
+
+    // The can set first is still there and plans.
+    assert_eq!(p.object().unwrap().name, before);
+    plan(&mut p).unwrap();
+}
+
+#[test]
+fn unseen_mesh_is_planned() {
+    // A mesh that is not in models/: a 60 mm box-ish bottle written on the fly.
+    let mut p = ready();
+    let mesh = TriangleMesh::lathe(&[(0.0, 0.03), (0.10, 0.03), (0.12, 0.02)], 20);
+    let path = tmp("unseen.obj");
+    mesh.write_obj(&path).unwrap();
+    let mut req = mesh_object(&path, 0.12);
+    req.pose = Pose::at([0.52, -0.25, 1.10]);
+    let s = p.set_object(&req).unwrap();
+    assert!(!s.regions.is_empty());
+    let r = plan(&mut p).unwrap();
+    assert!(r.force_closure.exact_resists_weight);
+}
+
+#[test]
+fn bad_env_and_options_are_refused() {
+    let mut p = ready();
+    let n = p
+        .remove_env(&RemoveEnv {
+            names: vec![],
+            all: false,
+        })
+        .unwrap()
+        .obstacles
+        .len();
+    let e = p
+        .set_env(&SetEnv {
+            obstacles: vec![Obstacle {
+                name: "wall".into(),
+                shape: ObstacleShape::Box {
+                    size: [1.0, -1.0, 1.0],
+                },
+                pose: Pose::default(),
+            }],
+            replace: true,
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("wall"), "{e}");
+    let e = p
+        .remove_env(&RemoveEnv {
+            names: vec!["nope".into()],
+            all: false,
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("nope"));
+    // Nothing was replaced or removed.
+    let after = p
+        .remove_env(&RemoveEnv {
+            names: vec![],
+            all: false,
+        })
+        .unwrap();
+    assert_eq!(after.obstacles.len(), n);
+
+    let e = p
+        .plan(
+            &PlanOptions {
+                grasp_types: Some(vec!["pinch".into()]),
+                ..PlanOptions::default()
+            },
+            &AtomicBool::new(false),
+            &mut |_| {},
+        )
+        .unwrap_err();
+    assert_eq!(e.code(), "bad_options");
+}
+
+#[test]
+fn heavy_or_huge_objects_fit_no_grasp_type() {
+    let mut p = ready();
+    let path = tmp("can2.stl");
+    TriangleMesh::cylinder(0.033, 0.122, 24)
+        .write_stl(&path)
+        .unwrap();
+    p.set_object(&mesh_object(&path, 5.0)).unwrap();
+    let e = plan(&mut p).unwrap_err();
+    assert_eq!(e.code(), "no_grasp_type");
+    assert!(e.to_string().contains("heavier"), "{e}");
+    let path = tmp("big.stl");
+    TriangleMesh::cuboid(Vector3::new(0.5, 0.5, 0.5))
+        .write_stl(&path)
+        .unwrap();
+    p.set_object(&mesh_object(&path, 0.1)).unwrap();
+    let e = plan(&mut p).unwrap_err();
+    assert!(e.to_string().contains("GRCmax"), "{e}");
+}
+
+#[test]
+fn far_object_is_unreachable_even_with_squat() {
+    let mut p = ready();
+    let path = tmp("far.stl");
+    TriangleMesh::cylinder(0.033, 0.122, 24)
+        .write_stl(&path)
+        .unwrap();
+    let mut req = mesh_object(&path, 0.15);
+    req.pose = Pose::at([2.0, -0.25, 1.0]);
+    p.set_object(&req).unwrap();
+    let e = plan(&mut p).unwrap_err();
+    assert_eq!(e.code(), "unreachable");
+    assert!(e.to_string().contains("squat_z"), "{e}");
+}
+
+#[test]
+fn cancel_stops_the_plan_and_progress_is_reported() {
+    let mut p = ready();
+    // An unreachable margin keeps Algorithm 1 sampling until stopped.
+    let cancel = AtomicBool::new(false);
+    let mut events = Vec::new();
+    let r = p.plan(
+        &PlanOptions {
+            max_samples: 100_000,
+            time_budget_ms: 600_000,
+            delta_f: Some(1000.0),
+            ..PlanOptions::default()
+        },
+        &cancel,
+        &mut |e| {
+            events.push(e.phase);
+            if e.phase == PlanPhase::Search && e.samples >= 32 {
+                cancel.store(true, Ordering::Relaxed);
+            }
+        },
+    );
+    match r {
+        Err(PlanError::Cancelled) => {}
+        other => panic!("expected a cancelled plan, got {other:?}"),
+    }
+    assert_eq!(events.first(), Some(&PlanPhase::Selection));
+    assert!(events.contains(&PlanPhase::Search));
+    // The state survives: plan again.
+    plan(&mut p).unwrap();
+}

@@ -1,0 +1,226 @@
+//! The paper's scenarios (`models/scenes/`), planned in-process: each asserts
+//! the outcome the paper reports, and every returned grasp is checked
+//! independently — the exact friction-cone test with its weight
+//! (`tsukami-grasp`) from the reply's contacts, and no collision of the robot
+//! at the reply's joint positions with the scene's obstacles (`tsukami-body`).
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use nalgebra::{Point3, Vector3};
+use tsukami_body::collision::RobotCollision;
+use tsukami_body::kinematics::FkState;
+use tsukami_body::scene::Scene;
+use tsukami_grasp::contact::Contact;
+use tsukami_grasp::exact::{exact_test, ConeModel};
+use tsukami_grasp::grasp::Grasp;
+use tsukami_grasp_planner::planner::{PlanError, Planner};
+use tsukami_grasp_planner::scene::scene_requests;
+use tsukami_msgs::planner::{GraspStyle, PlanOptions, PlanReply, WholeBody};
+
+fn models() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
+}
+
+fn scene_path(name: &str) -> PathBuf {
+    models().join("scenes").join(format!("{name}.toml"))
+}
+
+/// A planner set up for `scene`, and the number of OCP regions of its object.
+fn setup(scene: &str) -> (Planner, usize) {
+    let req = scene_requests(&scene_path(scene)).unwrap();
+    let mut p = Planner::new(models());
+    p.set_robot(&req.robot).unwrap();
+    let obj = p.set_object(&req.object).unwrap();
+    p.set_env(&req.env).unwrap();
+    (p, obj.regions.len())
+}
+
+fn plan(p: &mut Planner, opts: &PlanOptions) -> Result<PlanReply, PlanError> {
+    p.plan(opts, &AtomicBool::new(false), &mut |_| {})
+}
+
+/// Exact test from the reply alone: contacts within circular friction cones
+/// and their `f_max` hold the weight.
+fn assert_exact_force_closure(r: &PlanReply) {
+    let contacts: Vec<Contact> = r
+        .contacts
+        .iter()
+        .map(|c| Contact::new(Point3::from(c.position), Vector3::from(c.normal)).unwrap())
+        .collect();
+    let limits = r.contacts.iter().map(|c| c.f_max).collect();
+    let com = Point3::from(r.object.center_of_mass);
+    let grasp =
+        Grasp::with_force_limits(contacts, limits, r.mu, r.characteristic_length, com).unwrap();
+    let weight = grasp.weight_wrench(r.object.mass, &Vector3::new(0.0, 0.0, -9.81), &com);
+    let t = exact_test(&grasp, ConeModel::Circular, &weight).unwrap();
+    assert!(
+        t.resists_weight(),
+        "exact test: weight scale {}",
+        t.weight.weight_scale
+    );
+    assert!(r.force_closure.exact_resists_weight);
+    assert!(
+        r.force_closure.margin >= 0.0,
+        "margin {}",
+        r.force_closure.margin
+    );
+    for c in &r.contacts {
+        assert!(c.f_max > 0.0);
+        assert!((Vector3::from(c.normal).norm() - 1.0).abs() < 1e-6);
+    }
+}
+
+/// The robot at the reply's joint positions touches no obstacle of the scene.
+fn assert_collision_free(scene: &str, r: &PlanReply) {
+    let s = Scene::load(&scene_path(scene)).unwrap();
+    let q = s
+        .robot
+        .positions_from_named(
+            r.joint_positions
+                .iter()
+                .filter(|(n, _)| {
+                    let j = s.robot.joint_id(n).unwrap();
+                    s.robot.joints[j].mimic.is_none()
+                })
+                .map(|(n, v)| (n.as_str(), *v)),
+        )
+        .unwrap();
+    let mut fk = FkState::new(&s.robot);
+    fk.base = s.robot_base;
+    s.robot.forward_kinematics(&q, &mut fk);
+    let col = RobotCollision::new(&s.robot).unwrap();
+    let links: Vec<usize> = (0..s.robot.links.len()).collect();
+    let hit = col.first_collision(&fk, &links, &s.obstacle_refs(), 0.0);
+    assert!(hit.is_none(), "{scene}: robot touches an obstacle: {hit:?}");
+    // The palm is where the reply says.
+    let palm = s.robot.link_id("r_palm").unwrap();
+    let p = fk.pose(palm).translation.vector;
+    assert!((p - Vector3::from(r.palm_pose.position)).norm() < 2e-3);
+}
+
+#[test]
+fn can_at_breast_height_fingertip4_on_the_side_arm_only() {
+    let (mut p, _) = setup("can_breast");
+    let r = plan(&mut p, &PlanOptions::default()).unwrap();
+    assert_eq!(
+        r.grasp_type.style,
+        GraspStyle::Fingertip4,
+        "{:?}",
+        r.grasp_type
+    );
+    assert!(r.joints_used.is_empty(), "{:?}", r.joints_used);
+    // The side: the approach (palm normal) is horizontal.
+    let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+        r.palm_pose.quaternion[3],
+        r.palm_pose.quaternion[0],
+        r.palm_pose.quaternion[1],
+        r.palm_pose.quaternion[2],
+    ));
+    assert!(
+        (q * Vector3::z()).z.abs() < 0.2,
+        "approach {:?}",
+        q * Vector3::z()
+    );
+    assert_eq!(r.contacts.len(), 4);
+    assert_exact_force_closure(&r);
+    assert_collision_free("can_breast", &r);
+}
+
+#[test]
+fn can_at_waist_height_fingertip3_from_the_top() {
+    let (mut p, _) = setup("can_waist");
+    let r = plan(&mut p, &PlanOptions::default()).unwrap();
+    assert_eq!(
+        r.grasp_type.style,
+        GraspStyle::Fingertip3,
+        "{:?}",
+        r.grasp_type
+    );
+    let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+        r.palm_pose.quaternion[3],
+        r.palm_pose.quaternion[0],
+        r.palm_pose.quaternion[1],
+        r.palm_pose.quaternion[2],
+    ));
+    // From the top: the approach points down.
+    assert!(
+        (q * Vector3::z()).z < -0.9,
+        "approach {:?}",
+        q * Vector3::z()
+    );
+    assert!(r.joints_used.is_empty(), "{:?}", r.joints_used);
+    assert_eq!(r.contacts.len(), 3);
+    assert_exact_force_closure(&r);
+    assert_collision_free("can_waist", &r);
+}
+
+#[test]
+fn heavy_object_low_envelope4_with_squat() {
+    let (mut p, _) = setup("heavy_low");
+    let r = plan(&mut p, &PlanOptions::default()).unwrap();
+    assert_eq!(
+        r.grasp_type.style,
+        GraspStyle::Envelope4,
+        "{:?}",
+        r.grasp_type
+    );
+    assert!(
+        r.joints_used.iter().any(|j| j == "squat_z"),
+        "{:?}",
+        r.joints_used
+    );
+    assert!(r.joint_positions["squat_z"] < -0.01);
+    assert_exact_force_closure(&r);
+    assert_collision_free("heavy_low", &r);
+}
+
+#[test]
+fn pet_bottle_in_fridge_arm_fails_squat_succeeds() {
+    let (mut p, _) = setup("fridge_pet");
+    let arm_only = PlanOptions {
+        whole_body: WholeBody::ArmOnly,
+        ..PlanOptions::default()
+    };
+    let e = plan(&mut p, &arm_only).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            PlanError::Unreachable(_) | PlanError::NoForceClosure { .. }
+        ),
+        "{e}"
+    );
+    let r = plan(&mut p, &PlanOptions::default()).unwrap();
+    assert!(
+        r.joints_used.iter().any(|j| j == "squat_z"),
+        "{:?}",
+        r.joints_used
+    );
+    assert!(r.joint_positions["squat_z"] < -0.01);
+    assert_exact_force_closure(&r);
+    assert_collision_free("fridge_pet", &r);
+}
+
+#[test]
+fn vase_splits_into_regions_and_one_is_grasped() {
+    let (mut p, regions) = setup("vase_table");
+    assert!(regions >= 2, "{regions} regions");
+    let r = plan(&mut p, &PlanOptions::default()).unwrap();
+    assert!(r.ocp_region < regions);
+    assert_exact_force_closure(&r);
+    assert_collision_free("vase_table", &r);
+}
+
+#[test]
+fn same_seed_same_grasp() {
+    let (mut p, _) = setup("can_breast");
+    let opts = PlanOptions {
+        seed: 42,
+        ..PlanOptions::default()
+    };
+    let a = plan(&mut p, &opts).unwrap();
+    let b = plan(&mut p, &opts).unwrap();
+    assert_eq!(a.joint_positions, b.joint_positions);
+    assert_eq!(a.contacts, b.contacts);
+    assert_eq!(a.samples, b.samples);
+}
