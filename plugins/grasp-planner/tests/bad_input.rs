@@ -158,9 +158,9 @@ fn bad_objects_are_refused_and_the_state_is_kept() {
 
 #[test]
 fn unseen_mesh_is_planned() {
-    // A mesh that is not in models/: a 60 mm box-ish bottle written on the fly.
+    // A mesh that is not in models/: a 60 mm jar written on the fly.
     let mut p = ready();
-    let mesh = TriangleMesh::lathe(&[(0.0, 0.03), (0.10, 0.03), (0.12, 0.02)], 20);
+    let mesh = TriangleMesh::lathe(&[(0.03, 0.0), (0.03, 0.10), (0.02, 0.12)], 20);
     let path = tmp("unseen.obj");
     mesh.write_obj(&path).unwrap();
     let mut req = mesh_object(&path, 0.12);
