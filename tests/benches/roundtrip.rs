@@ -42,9 +42,14 @@ fn us(d: Duration) -> f64 {
 
 fn main() {
     // Through the host into the `test-slow` fixture plugin's `echo` command.
-    let bus = TestBus::start(test_config(vec![plugin_entry("test-slow", "tsukami_test_slow")]));
+    let bus = TestBus::start(test_config(vec![plugin_entry(
+        "test-slow",
+        "tsukami_test_slow",
+    )]));
     let (host_p50, host_p99) = measure(|| {
-        bus.client.command("test-slow", "echo", b"", T).expect("echo reply");
+        bus.client
+            .command("test-slow", "echo", b"", T)
+            .expect("echo reply");
     });
 
     // Bare zenoh: a queryable on its own peer session that replies with the query's
@@ -55,13 +60,19 @@ fn main() {
     let _echo = server
         .declare_queryable("bare/echo")
         .callback(|query| {
-            let payload = query.payload().map(|p| p.to_bytes().into_owned()).unwrap_or_default();
+            let payload = query
+                .payload()
+                .map(|p| p.to_bytes().into_owned())
+                .unwrap_or_default();
             let _ = query.reply(query.key_expr().clone(), payload).wait();
         })
         .wait()
         .unwrap();
     let client = BusClient::connect(&BusConfig::connecting(&endpoint), "bare").unwrap();
-    while client.request_key("bare/echo", b"", Duration::from_millis(200)).is_err() {}
+    while client
+        .request_key("bare/echo", b"", Duration::from_millis(200))
+        .is_err()
+    {}
     let (bare_p50, bare_p99) = measure(|| {
         client.request_key("bare/echo", b"", T).expect("bare reply");
     });
@@ -70,12 +81,17 @@ fn main() {
     let mut stops: Vec<Duration> = (0..20)
         .map(|_| {
             std::thread::scope(|scope| {
-                let running = scope.spawn(|| bus.client.command("test-slow", "work", br#"{"ms": 10000}"#, T));
+                let running = scope.spawn(|| {
+                    bus.client
+                        .command("test-slow", "work", br#"{"ms": 10000}"#, T)
+                });
                 // Ask until the call is running (stop answers `stopped: false` before).
                 loop {
                     let start = Instant::now();
                     let reply = bus.client.command("test-slow", "stop", b"", T).unwrap();
-                    if serde_json::from_slice::<serde_json::Value>(&reply).unwrap()["stopped"] == true {
+                    if serde_json::from_slice::<serde_json::Value>(&reply).unwrap()["stopped"]
+                        == true
+                    {
                         assert!(running.join().unwrap().is_err());
                         break start.elapsed();
                     }
@@ -85,10 +101,26 @@ fn main() {
         .collect();
     stops.sort();
 
-    println!("round trip of an empty request, {SAMPLES} samples after {WARM_UP} warm-up, loopback TCP:");
-    println!("  {:<34} p50 {:>8.1} µs   p99 {:>8.1} µs", "client -> host -> plugin -> client", us(host_p50), us(host_p99));
-    println!("  {:<34} p50 {:>8.1} µs   p99 {:>8.1} µs", "bare zenoh get/reply", us(bare_p50), us(bare_p99));
-    println!("  ratio host / bare: p50 {:.2}x   p99 {:.2}x", us(host_p50) / us(bare_p50), us(host_p99) / us(bare_p99));
+    println!(
+        "round trip of an empty request, {SAMPLES} samples after {WARM_UP} warm-up, loopback TCP:"
+    );
+    println!(
+        "  {:<34} p50 {:>8.1} µs   p99 {:>8.1} µs",
+        "client -> host -> plugin -> client",
+        us(host_p50),
+        us(host_p99)
+    );
+    println!(
+        "  {:<34} p50 {:>8.1} µs   p99 {:>8.1} µs",
+        "bare zenoh get/reply",
+        us(bare_p50),
+        us(bare_p99)
+    );
+    println!(
+        "  ratio host / bare: p50 {:.2}x   p99 {:.2}x",
+        us(host_p50) / us(bare_p50),
+        us(host_p99) / us(bare_p99)
+    );
     println!(
         "stop -> cancelled reply of a running call (20 samples): p50 {:.2} ms   max {:.2} ms",
         stops[stops.len() / 2].as_secs_f64() * 1e3,

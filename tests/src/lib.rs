@@ -17,7 +17,10 @@ use tsukami::server::RunningHost;
 fn build_dirs() -> Vec<PathBuf> {
     let exe = std::env::current_exe().expect("current_exe");
     let deps = exe.parent().expect("test binary folder").to_owned();
-    let profile = deps.parent().map(Path::to_owned).unwrap_or_else(|| deps.clone());
+    let profile = deps
+        .parent()
+        .map(Path::to_owned)
+        .unwrap_or_else(|| deps.clone());
     vec![deps, profile]
 }
 
@@ -28,16 +31,47 @@ pub fn plugin_file(lib_name: &str) -> PathBuf {
         .into_iter()
         .map(|d| d.join(&file))
         .find(|p| p.is_file())
-        .unwrap_or_else(|| panic!("{file} was not built; is its crate a dev-dependency of tsukami-e2e?"))
+        .unwrap_or_else(|| {
+            panic!("{file} was not built; is its crate a dev-dependency of tsukami-e2e?")
+        })
 }
 
 fn tsukami_plugin_api_file_name(lib_name: &str) -> String {
-    format!("{}{lib_name}{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX)
+    format!(
+        "{}{lib_name}{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    )
 }
 
 /// A config entry loading `lib_name`'s file for `role`.
 pub fn plugin_entry(role: &str, lib_name: &str) -> PluginEntryConfig {
-    PluginEntryConfig { role: role.to_owned(), library: None, path: Some(plugin_file(lib_name)), config: None }
+    PluginEntryConfig {
+        role: role.to_owned(),
+        library: None,
+        path: Some(plugin_file(lib_name)),
+        config: None,
+    }
+}
+
+/// The repository's `models/` folder.
+pub fn models_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../models")
+}
+
+/// A config entry loading the built-in grasp planner with the repository's models.
+pub fn planner_entry() -> PluginEntryConfig {
+    let mut entry = plugin_entry(
+        tsukami_msgs::keys::ROLE_GRASP_PLANNER,
+        "tsukami_grasp_planner",
+    );
+    let mut table = toml::Table::new();
+    table.insert(
+        "models_dir".into(),
+        models_dir().display().to_string().into(),
+    );
+    entry.config = Some(table);
+    entry
 }
 
 /// A host on a free loopback port with its own namespace, plus a connected client.
@@ -64,9 +98,16 @@ impl TestBus {
     pub fn start(config: HostConfig) -> TestBus {
         let endpoint = config.bus.listen[0].clone();
         let host = RunningHost::start(&config).expect("host starts");
-        let client = BusClient::connect(&BusConfig::connecting(&endpoint), &config.namespace).expect("client connects");
-        client.wait_for_host(Duration::from_secs(20)).expect("host answers");
-        TestBus { host, client, endpoint }
+        let client = BusClient::connect(&BusConfig::connecting(&endpoint), &config.namespace)
+            .expect("client connects");
+        client
+            .wait_for_host(Duration::from_secs(20))
+            .expect("host answers");
+        TestBus {
+            host,
+            client,
+            endpoint,
+        }
     }
 }
 
@@ -74,13 +115,24 @@ impl TestBus {
 /// (the app has integration tests); when a narrower command did not, build it.
 pub fn tsukami_exe() -> PathBuf {
     let name = format!("tsukami{}", std::env::consts::EXE_SUFFIX);
-    if let Some(found) = build_dirs().into_iter().map(|d| d.join(&name)).find(|p| p.is_file()) {
+    if let Some(found) = build_dirs()
+        .into_iter()
+        .map(|d| d.join(&name))
+        .find(|p| p.is_file())
+    {
         return found;
     }
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    let status = Command::new(cargo).args(["build", "-p", "tsukami"]).status().expect("running cargo build");
+    let status = Command::new(cargo)
+        .args(["build", "-p", "tsukami"])
+        .status()
+        .expect("running cargo build");
     assert!(status.success(), "cargo build -p tsukami failed");
-    build_dirs().into_iter().map(|d| d.join(&name)).find(|p| p.is_file()).expect("tsukami binary after build")
+    build_dirs()
+        .into_iter()
+        .map(|d| d.join(&name))
+        .find(|p| p.is_file())
+        .expect("tsukami binary after build")
 }
 
 /// A child process killed when dropped.

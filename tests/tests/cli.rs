@@ -19,13 +19,27 @@ fn plugins_lists_what_a_running_host_serves() {
         ),
     )
     .unwrap();
-    let _host = spawn_tsukami(&["run", "--config", config.to_str().unwrap(), "--namespace", &namespace]);
+    let _host = spawn_tsukami(&[
+        "run",
+        "--config",
+        config.to_str().unwrap(),
+        "--namespace",
+        &namespace,
+    ]);
 
     // Ask until the host is up (a query before its queryable exists goes unanswered).
     let mut listing = None;
     for _ in 0..40 {
         let out = std::process::Command::new(tsukami_exe())
-            .args(["plugins", "--connect", &endpoint, "--namespace", &namespace, "--timeout-ms", "500"])
+            .args([
+                "plugins",
+                "--connect",
+                &endpoint,
+                "--namespace",
+                &namespace,
+                "--timeout-ms",
+                "500",
+            ])
             .output()
             .unwrap();
         if out.status.success() {
@@ -41,7 +55,15 @@ fn plugins_lists_what_a_running_host_serves() {
 
     // The planner role is not served by this host: the client times out and says so.
     let out = std::process::Command::new(tsukami_exe())
-        .args(["stop", "--connect", &endpoint, "--namespace", &namespace, "--timeout-ms", "300"])
+        .args([
+            "stop",
+            "--connect",
+            &endpoint,
+            "--namespace",
+            &namespace,
+            "--timeout-ms",
+            "300",
+        ])
         .output()
         .unwrap();
     assert!(!out.status.success());

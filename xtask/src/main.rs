@@ -33,7 +33,9 @@ fn run_release(subcommand: &str, rest: &[String]) -> ExitCode {
     let target = std::env::var("CARGO_TARGET_DIR")
         .map(std::path::PathBuf::from)
         .unwrap_or_else(|_| root.join("target"));
-    let exe = target.join("release").join(format!("tsukami{}", std::env::consts::EXE_SUFFIX));
+    let exe = target
+        .join("release")
+        .join(format!("tsukami{}", std::env::consts::EXE_SUFFIX));
     match Command::new(&exe).arg(subcommand).args(rest).status() {
         Ok(status) if status.success() => ExitCode::SUCCESS,
         Ok(status) => ExitCode::from(u8::try_from(status.code().unwrap_or(1)).unwrap_or(1)),

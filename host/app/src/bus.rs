@@ -37,12 +37,20 @@ pub struct BusConfig {
 impl BusConfig {
     /// A host listening on `endpoint`.
     pub fn listening(endpoint: &str) -> Self {
-        BusConfig { listen: vec![endpoint.to_owned()], connect: vec![], zenoh_config: None }
+        BusConfig {
+            listen: vec![endpoint.to_owned()],
+            connect: vec![],
+            zenoh_config: None,
+        }
     }
 
     /// A client connecting to `endpoint` (listening nowhere).
     pub fn connecting(endpoint: &str) -> Self {
-        BusConfig { listen: vec![], connect: vec![endpoint.to_owned()], zenoh_config: None }
+        BusConfig {
+            listen: vec![],
+            connect: vec![endpoint.to_owned()],
+            zenoh_config: None,
+        }
     }
 
     /// Builds the zenoh config.
@@ -62,8 +70,16 @@ impl BusConfig {
                 .map_err(|e| anyhow::anyhow!("zenoh config `{key}` = {value}: {e}"))
         };
         set(&mut config, "mode", "\"peer\"".into())?;
-        set(&mut config, "listen/endpoints", serde_json::to_string(&self.listen)?)?;
-        set(&mut config, "connect/endpoints", serde_json::to_string(&self.connect)?)?;
+        set(
+            &mut config,
+            "listen/endpoints",
+            serde_json::to_string(&self.listen)?,
+        )?;
+        set(
+            &mut config,
+            "connect/endpoints",
+            serde_json::to_string(&self.connect)?,
+        )?;
         set(&mut config, "scouting/multicast/enabled", "false".into())?;
         set(&mut config, "scouting/gossip/enabled", "false".into())?;
         Ok(config)
@@ -90,7 +106,9 @@ impl BusConfig {
 /// only. (A zenoh config file is the way to reach other machines.)
 pub fn check_loopback(endpoint: &str) -> Result<()> {
     let Some(address) = endpoint.strip_prefix("tcp/") else {
-        bail!("endpoint `{endpoint}`: only tcp/127.0.0.1:PORT is allowed without a zenoh config file");
+        bail!(
+            "endpoint `{endpoint}`: only tcp/127.0.0.1:PORT is allowed without a zenoh config file"
+        );
     };
     let host = address.rsplit_once(':').map(|(h, _)| h).unwrap_or(address);
     if host != "127.0.0.1" && host != "localhost" && host != "[::1]" {
@@ -112,7 +130,9 @@ mod tests {
 
     #[test]
     fn defaults_are_loopback_without_scouting() {
-        let config = BusConfig::listening("tcp/127.0.0.1:7000").to_zenoh().unwrap();
+        let config = BusConfig::listening("tcp/127.0.0.1:7000")
+            .to_zenoh()
+            .unwrap();
         let text = format!("{config}");
         assert!(text.contains("127.0.0.1:7000"), "{text}");
         let multicast = config.get_json("scouting/multicast/enabled").unwrap();
@@ -127,6 +147,8 @@ mod tests {
         assert!(check_loopback("tcp/0.0.0.0:1").is_err());
         assert!(check_loopback("tcp/[::]:1").is_err());
         assert!(check_loopback("udp/127.0.0.1:1").is_err());
-        assert!(BusConfig::connecting("tcp/10.0.0.1:7447").to_zenoh().is_err());
+        assert!(BusConfig::connecting("tcp/10.0.0.1:7447")
+            .to_zenoh()
+            .is_err());
     }
 }

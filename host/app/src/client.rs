@@ -51,7 +51,10 @@ pub struct BusClient {
 impl BusClient {
     /// Joins the bus (the built-in config connects to loopback only).
     pub fn connect(bus: &BusConfig, namespace: &str) -> Result<BusClient> {
-        Ok(BusClient { session: bus.open()?, keys: KeySpace::new(namespace) })
+        Ok(BusClient {
+            session: bus.open()?,
+            keys: KeySpace::new(namespace),
+        })
     }
 
     /// The key space.
@@ -65,8 +68,16 @@ impl BusClient {
     }
 
     /// Queries `key` (a full key) with `payload` and returns the first reply's bytes.
-    pub fn request_key(&self, key: &str, payload: &[u8], timeout: Duration) -> Result<Vec<u8>, RequestError> {
-        let bus_error = |e: zenoh::Error| RequestError::Bus { key: key.to_owned(), message: e.to_string() };
+    pub fn request_key(
+        &self,
+        key: &str,
+        payload: &[u8],
+        timeout: Duration,
+    ) -> Result<Vec<u8>, RequestError> {
+        let bus_error = |e: zenoh::Error| RequestError::Bus {
+            key: key.to_owned(),
+            message: e.to_string(),
+        };
         let replies = self
             .session
             .get(key)
@@ -75,22 +86,34 @@ impl BusClient {
             .timeout(timeout)
             .wait()
             .map_err(bus_error)?;
-        let reply = replies
-            .recv()
-            .map_err(|_| RequestError::Timeout { key: key.to_owned(), timeout })?;
+        let reply = replies.recv().map_err(|_| RequestError::Timeout {
+            key: key.to_owned(),
+            timeout,
+        })?;
         match reply.result() {
             Ok(sample) => Ok(sample.payload().to_bytes().into_owned()),
             Err(err) => {
                 let bytes = err.payload().to_bytes();
-                Err(RequestError::Reply(serde_json::from_slice(&bytes).unwrap_or_else(|_| {
-                    ErrorReply::new(ErrorCode::Internal, String::from_utf8_lossy(&bytes).into_owned())
-                })))
+                Err(RequestError::Reply(
+                    serde_json::from_slice(&bytes).unwrap_or_else(|_| {
+                        ErrorReply::new(
+                            ErrorCode::Internal,
+                            String::from_utf8_lossy(&bytes).into_owned(),
+                        )
+                    }),
+                ))
             }
         }
     }
 
     /// Sends `command` to `role`'s plugin (`<ns>/<role prefix>/<command>`).
-    pub fn command(&self, role: &str, command: &str, payload: &[u8], timeout: Duration) -> Result<Vec<u8>, RequestError> {
+    pub fn command(
+        &self,
+        role: &str,
+        command: &str,
+        payload: &[u8],
+        timeout: Duration,
+    ) -> Result<Vec<u8>, RequestError> {
         self.request_key(&self.keys.command(role, command), payload, timeout)
     }
 
@@ -102,9 +125,16 @@ impl BusClient {
         loop {
             let left = deadline.saturating_sub(start.elapsed());
             if left.is_zero() {
-                return Err(anyhow!("no Tsukami host answered on {} within {deadline:?}", self.keys.host_plugins()));
+                return Err(anyhow!(
+                    "no Tsukami host answered on {} within {deadline:?}",
+                    self.keys.host_plugins()
+                ));
             }
-            match self.request_key(&self.keys.host_plugins(), b"", left.min(Duration::from_millis(250))) {
+            match self.request_key(
+                &self.keys.host_plugins(),
+                b"",
+                left.min(Duration::from_millis(250)),
+            ) {
                 Ok(bytes) => return Ok(serde_json::from_slice(&bytes)?),
                 Err(RequestError::Timeout { .. }) => continue,
                 Err(e) => return Err(e.into()),

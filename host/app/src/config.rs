@@ -58,7 +58,9 @@ pub struct Limits {
 
 impl Default for Limits {
     fn default() -> Self {
-        Limits { max_payload_bytes: default_max_payload() }
+        Limits {
+            max_payload_bytes: default_max_payload(),
+        }
     }
 }
 
@@ -108,7 +110,8 @@ library = "tsukami_grasp_planner"
 impl HostConfig {
     /// Parses config text; relative paths will resolve against `base_dir`.
     pub fn parse(text: &str, base_dir: &Path, origin: &str) -> Result<HostConfig> {
-        let mut config: HostConfig = toml::from_str(text).with_context(|| format!("parsing host config {origin}"))?;
+        let mut config: HostConfig =
+            toml::from_str(text).with_context(|| format!("parsing host config {origin}"))?;
         config.base_dir = base_dir.to_owned();
         for entry in &config.plugins {
             if entry.library.is_some() == entry.path.is_some() {
@@ -120,14 +123,25 @@ impl HostConfig {
 
     /// Reads a config file.
     pub fn from_file(path: &Path) -> Result<HostConfig> {
-        let text = std::fs::read_to_string(path).with_context(|| format!("reading host config {}", path.display()))?;
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("reading host config {}", path.display()))?;
         let base = path.parent().unwrap_or(Path::new("."));
         HostConfig::parse(&text, base, &path.display().to_string())
     }
 
-    /// The embedded default config, with plugins resolved beside the executable.
+    /// The embedded default config, with plugins resolved beside the executable and
+    /// the planner pointed at the project's `models/` ([`default_models_dir`]).
     pub fn default_config() -> Result<HostConfig> {
-        HostConfig::parse(DEFAULT_CONFIG, Path::new("."), "(built-in default)")
+        let mut config = HostConfig::parse(DEFAULT_CONFIG, Path::new("."), "(built-in default)")?;
+        let models = default_models_dir();
+        for entry in &mut config.plugins {
+            let table = entry.config.get_or_insert_with(toml::Table::new);
+            table.insert(
+                "models_dir".into(),
+                toml::Value::String(models.display().to_string()),
+            );
+        }
+        Ok(config)
     }
 
     /// A config with no plugins (tests add their own).
@@ -148,11 +162,14 @@ impl HostConfig {
         }
         let name = entry.library.as_deref().unwrap_or_default();
         let given = Path::new(name);
-        let file_name = library_file_name(given.file_name().and_then(|n| n.to_str()).unwrap_or(name));
+        let file_name =
+            library_file_name(given.file_name().and_then(|n| n.to_str()).unwrap_or(name));
         if given.parent().is_some_and(|p| !p.as_os_str().is_empty()) {
             return Ok(self.base_dir.join(given.with_file_name(file_name)));
         }
-        let candidates = plugin_search_dirs().into_iter().map(|dir| dir.join(&file_name));
+        let candidates = plugin_search_dirs()
+            .into_iter()
+            .map(|dir| dir.join(&file_name));
         let tried: Vec<PathBuf> = candidates.collect();
         tried
             .iter()
@@ -162,11 +179,30 @@ impl HostConfig {
     }
 }
 
+/// The model library the built-in config hands the planner: `$TSUKAMI_MODELS`, else
+/// the first `models/` folder (holding `robots/`) found walking up from the executable
+/// (`target/release/tsukami` → the repository), else `./models`.
+pub fn default_models_dir() -> PathBuf {
+    if let Some(dir) = std::env::var_os("TSUKAMI_MODELS") {
+        return PathBuf::from(dir);
+    }
+    let exe = std::env::current_exe().ok();
+    exe.iter()
+        .flat_map(|e| e.ancestors().skip(1))
+        .map(|dir| dir.join("models"))
+        .find(|models| models.join("robots").is_dir())
+        .unwrap_or_else(|| PathBuf::from("models"))
+}
+
 /// Where plugins named without a folder are looked for: the executable's folder,
 /// its `deps/` and (for test binaries, which live in `deps/`) the folder above.
 pub fn plugin_search_dirs() -> Vec<PathBuf> {
-    let Ok(exe) = std::env::current_exe() else { return vec![] };
-    let Some(dir) = exe.parent() else { return vec![] };
+    let Ok(exe) = std::env::current_exe() else {
+        return vec![];
+    };
+    let Some(dir) = exe.parent() else {
+        return vec![];
+    };
     let mut dirs = vec![dir.to_owned(), dir.join("deps")];
     if dir.ends_with("deps") {
         if let Some(up) = dir.parent() {
@@ -201,6 +237,9 @@ mod tests {
         let text = "[[plugin]]\nrole = \"a\"\nlibrary = \"plugins/my_planner\"\n";
         let config = HostConfig::parse(text, Path::new("/etc/tsukami"), "t").unwrap();
         let file = config.plugin_file(&config.plugins[0]).unwrap();
-        assert_eq!(file, Path::new("/etc/tsukami/plugins").join(library_file_name("my_planner")));
+        assert_eq!(
+            file,
+            Path::new("/etc/tsukami/plugins").join(library_file_name("my_planner"))
+        );
     }
 }

@@ -1,48 +1,135 @@
 //! `tsukami demo`: the main job. Starts a private host with the workspace's plugins on
-//! a free loopback port, talks to it over the bus like any client would, and prints
-//! what it did.
+//! a free loopback port, then runs each of the paper's scenes through the bus with
+//! SetRobot / SetObject / SetEnv / Plan like any client would, and prints a table
+//! (or JSON). The exit status is non-zero if any scene's outcome differs from the
+//! paper's.
 
 use crate::bus::{free_loopback_port, BusConfig};
 use crate::client::BusClient;
-use crate::config::HostConfig;
+use crate::config::{default_models_dir, HostConfig};
+use crate::scenes::{run_scene, SceneOutcome};
 use crate::server::RunningHost;
-use anyhow::Result;
+use anyhow::{bail, Result};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
+use tsukami_scenes::PAPER_SCENES;
 
 /// Options of `tsukami demo`.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct DemoArgs {
-    /// Print JSON instead of a table.
+    /// Run only this scene (`can_breast`, `can_waist`, `heavy_low`, `fridge_pet`, `vase_table`).
+    #[arg(long)]
+    pub scene: Option<String>,
+    /// Random seed of the planner.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Print a JSON array of `{"scene", "expected", "ok", "result"}` instead of a table.
     #[arg(long)]
     pub json: bool,
 }
 
-/// Runs the demo; the exit status is non-zero if anything did not work.
+/// Runs the demo.
 pub fn run(args: &DemoArgs) -> Result<ExitCode> {
+    let scenes: Vec<_> = PAPER_SCENES
+        .iter()
+        .filter(|s| args.scene.as_deref().is_none_or(|n| n == s.name))
+        .collect();
+    if scenes.is_empty() {
+        let names: Vec<_> = PAPER_SCENES.iter().map(|s| s.name).collect();
+        bail!(
+            "no scene `{}`; the scenes are {names:?}",
+            args.scene.as_deref().unwrap_or_default()
+        );
+    }
+
     let port = free_loopback_port()?;
     let endpoint = format!("tcp/127.0.0.1:{port}");
     let mut config = HostConfig::default_config()?;
     config.namespace = format!("tsukami-demo-{port}");
     config.bus = BusConfig::listening(&endpoint);
+    let models = default_models_dir();
 
     let started = Instant::now();
     let host = RunningHost::start(&config)?;
     let client = BusClient::connect(&BusConfig::connecting(&endpoint), &config.namespace)?;
     let listing = client.wait_for_host(Duration::from_secs(10))?;
-    let ready = started.elapsed();
+    let ready_ms = started.elapsed().as_secs_f64() * 1e3;
+
+    let outcomes: Vec<SceneOutcome> = scenes
+        .iter()
+        .map(|scene| run_scene(&client, &models, scene, args.seed, Duration::from_secs(60)))
+        .collect();
 
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&listing)?);
+        println!("{}", serde_json::to_string_pretty(&outcomes)?);
     } else {
-        println!("Tsukami host on {endpoint} (namespace `{}`), ready in {:.0} ms", config.namespace, ready.as_secs_f64() * 1e3);
-        println!("plugin interface {}", listing.interface_version);
-        println!("{:<20} {:<28} {:<8} {}", "role", "plugin", "version", "file");
+        println!(
+            "Tsukami host on {endpoint}, namespace `{}`, ready in {ready_ms:.0} ms; plugins:",
+            config.namespace
+        );
         for plugin in &listing.plugins {
-            println!("{:<20} {:<28} {:<8} {}", plugin.roles.join(","), plugin.name, plugin.version, plugin.path);
+            println!(
+                "  {:<20} {} {}",
+                plugin.roles.join(","),
+                plugin.name,
+                plugin.version
+            );
         }
+        println!();
+        print_table(&outcomes);
     }
     client.close();
     host.shutdown();
-    Ok(ExitCode::SUCCESS)
+    let all_ok = outcomes.iter().all(|o| o.ok);
+    Ok(if all_ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
+
+fn print_table(outcomes: &[SceneOutcome]) {
+    println!(
+        "{:<11} {:<16} {:<6} {:<31} {:>7} {:>6} {:>9}  {}",
+        "scene", "grasp type", "face", "whole-body joints", "margin", "exact", "plan ms", "paper"
+    );
+    for o in outcomes {
+        let (grasp, face, joints, margin, exact) = match &o.result {
+            Some(r) => (
+                r.grasp_type.name.clone(),
+                format!(
+                    "{}:{}",
+                    r.ocp_region,
+                    serde_json::to_value(r.face)
+                        .ok()
+                        .and_then(|v| v.as_str().map(str::to_owned))
+                        .unwrap_or_default()
+                ),
+                if r.joints_used.is_empty() {
+                    "arm only".to_owned()
+                } else {
+                    r.joints_used.join(",")
+                },
+                format!("{:.3}", r.force_closure.margin),
+                if r.force_closure.exact_resists_weight {
+                    "holds"
+                } else {
+                    "FAILS"
+                }
+                .to_owned(),
+            ),
+            None => ("-".into(), "-".into(), "-".into(), "-".into(), "-".into()),
+        };
+        let verdict = if o.ok { "ok" } else { "DIFFERS" };
+        println!(
+            "{:<11} {:<16} {:<6} {:<31} {:>7} {:>6} {:>9.1}  {verdict}: {}",
+            o.scene, grasp, face, joints, margin, exact, o.plan_ms, o.expected
+        );
+        if let Some(arm_only) = &o.arm_only {
+            println!("{:<11} arm alone: {arm_only}", "");
+        }
+        if let Some(problem) = &o.problem {
+            println!("{:<11} problem: {problem}", "");
+        }
+    }
 }

@@ -29,8 +29,18 @@ pub struct BusHost {
 
 impl BusHost {
     /// The handle for `plugin`, whose progress goes to `progress_key`.
-    pub fn new(session: zenoh::Session, keys: KeySpace, progress_key: String, plugin: String) -> Self {
-        BusHost { session, keys, progress_key, plugin }
+    pub fn new(
+        session: zenoh::Session,
+        keys: KeySpace,
+        progress_key: String,
+        plugin: String,
+    ) -> Self {
+        BusHost {
+            session,
+            keys,
+            progress_key,
+            plugin,
+        }
     }
 
     /// Boxes it behind the stable vtable for the plugin's `new`.
@@ -42,17 +52,29 @@ impl BusHost {
 /// Turns an error reply's payload into the FFI error, keeping its code.
 pub fn call_error_from_reply(payload: &[u8]) -> FfiCallError {
     let reply = serde_json::from_slice::<ErrorReply>(payload).unwrap_or_else(|_| {
-        ErrorReply::new(ErrorCode::Internal, String::from_utf8_lossy(payload).into_owned())
+        ErrorReply::new(
+            ErrorCode::Internal,
+            String::from_utf8_lossy(payload).into_owned(),
+        )
     });
     FfiCallError {
         code: reply.error.code.as_str().into(),
         message: reply.error.message.as_str().into(),
-        details_json: reply.error.details.map(|d| d.to_string()).unwrap_or_default().into(),
+        details_json: reply
+            .error
+            .details
+            .map(|d| d.to_string())
+            .unwrap_or_default()
+            .into(),
     }
 }
 
 fn ffi_error(code: ErrorCode, message: String) -> FfiCallError {
-    FfiCallError { code: code.as_str().into(), message: message.into(), details_json: RString::new() }
+    FfiCallError {
+        code: code.as_str().into(),
+        message: message.into(),
+        details_json: RString::new(),
+    }
 }
 
 impl FfiHost for BusHost {
@@ -66,7 +88,12 @@ impl FfiHost for BusHost {
             .into()
     }
 
-    fn request(&self, key: RStr<'_>, payload: RSlice<'_, u8>, timeout_ms: u64) -> RResult<RVec<u8>, FfiCallError> {
+    fn request(
+        &self,
+        key: RStr<'_>,
+        payload: RSlice<'_, u8>,
+        timeout_ms: u64,
+    ) -> RResult<RVec<u8>, FfiCallError> {
         let key = self.keys.key(key.as_str());
         let replies = match self
             .session
@@ -77,7 +104,12 @@ impl FfiHost for BusHost {
             .wait()
         {
             Ok(replies) => replies,
-            Err(e) => return RResult::RErr(ffi_error(ErrorCode::Internal, format!("querying {key}: {e}"))),
+            Err(e) => {
+                return RResult::RErr(ffi_error(
+                    ErrorCode::Internal,
+                    format!("querying {key}: {e}"),
+                ))
+            }
         };
         match replies.recv() {
             Ok(reply) => match reply.result() {
@@ -94,7 +126,10 @@ impl FfiHost for BusHost {
     fn subscribe(&self, key: RStr<'_>) -> RResult<FfiSubscriptionBox, RString> {
         let key = self.keys.key(key.as_str());
         match self.session.declare_subscriber(&key).wait() {
-            Ok(subscriber) => RResult::ROk(FfiSubscription_TO::from_ptr(RBox::new(BusSubscription { subscriber }), TD_Opaque)),
+            Ok(subscriber) => RResult::ROk(FfiSubscription_TO::from_ptr(
+                RBox::new(BusSubscription { subscriber }),
+                TD_Opaque,
+            )),
             Err(e) => RResult::RErr(RString::from(format!("subscribing to {key}: {e}"))),
         }
     }
@@ -130,7 +165,10 @@ struct BusSubscription {
 
 impl FfiSubscription for BusSubscription {
     fn recv_timeout(&mut self, timeout_ms: u64) -> ROption<FfiSample> {
-        match self.subscriber.recv_timeout(Duration::from_millis(timeout_ms)) {
+        match self
+            .subscriber
+            .recv_timeout(Duration::from_millis(timeout_ms))
+        {
             Ok(Some(sample)) => ROption::RSome(FfiSample {
                 key: sample.key_expr().as_str().into(),
                 payload: RVec::from(sample.payload().to_bytes().into_owned()),

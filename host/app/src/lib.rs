@@ -11,6 +11,7 @@
 //!   queries to its plugin on a worker thread, answers `stop` and `host/plugins`.
 //! - [`host_handle`]: what a plugin reaches the bus through.
 //! - [`demo`]: `tsukami demo`, the main job.
+//! - [`scenes`]: the paper's scenes run over the bus and judged.
 //! - [`client`]: a small blocking client for the bus (CLI, demo, tests, benches).
 
 pub mod bus;
@@ -18,4 +19,5 @@ pub mod client;
 pub mod config;
 pub mod demo;
 pub mod host_handle;
+pub mod scenes;
 pub mod server;

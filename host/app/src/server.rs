@@ -52,9 +52,15 @@ impl Worker {
         match &current.command {
             Some(command) => {
                 current.cancel.store(true, Ordering::Relaxed);
-                StopReply { stopped: true, command: Some(command.clone()) }
+                StopReply {
+                    stopped: true,
+                    command: Some(command.clone()),
+                }
             }
-            None => StopReply { stopped: false, command: None },
+            None => StopReply {
+                stopped: false,
+                command: None,
+            },
         }
     }
 }
@@ -69,14 +75,22 @@ pub struct RunningHost {
 }
 
 fn reply_json(query: &Query, payload: Vec<u8>) {
-    if let Err(e) = query.reply(query.key_expr().clone(), payload).encoding(Encoding::APPLICATION_JSON).wait() {
+    if let Err(e) = query
+        .reply(query.key_expr().clone(), payload)
+        .encoding(Encoding::APPLICATION_JSON)
+        .wait()
+    {
         tracing::warn!("reply on {} failed: {e}", query.key_expr());
     }
 }
 
 fn reply_error(query: &Query, error: ErrorReply) {
     tracing::debug!("error reply on {}: {error}", query.key_expr());
-    if let Err(e) = query.reply_err(error.to_json_bytes()).encoding(Encoding::APPLICATION_JSON).wait() {
+    if let Err(e) = query
+        .reply_err(error.to_json_bytes())
+        .encoding(Encoding::APPLICATION_JSON)
+        .wait()
+    {
         tracing::warn!("error reply on {} failed: {e}", query.key_expr());
     }
 }
@@ -84,22 +98,37 @@ fn reply_error(query: &Query, error: ErrorReply) {
 /// Checks a request before it reaches a plugin: size and JSON syntax. An empty
 /// payload stands for `{}`.
 fn checked_payload(query: &Query, max_bytes: usize) -> Result<Vec<u8>, ErrorReply> {
-    let bytes = query.payload().map(|p| p.to_bytes().into_owned()).unwrap_or_default();
+    let bytes = query
+        .payload()
+        .map(|p| p.to_bytes().into_owned())
+        .unwrap_or_default();
     if bytes.len() > max_bytes {
         return Err(ErrorReply::new(
             ErrorCode::PayloadTooLarge,
-            format!("payload is {} bytes; this host accepts at most {max_bytes}", bytes.len()),
+            format!(
+                "payload is {} bytes; this host accepts at most {max_bytes}",
+                bytes.len()
+            ),
         ));
     }
     if bytes.iter().all(u8::is_ascii_whitespace) {
         return Ok(b"{}".to_vec());
     }
-    serde_json::from_slice::<serde::de::IgnoredAny>(&bytes)
-        .map_err(|e| ErrorReply::new(ErrorCode::MalformedJson, format!("payload is not valid JSON: {e}")))?;
+    serde_json::from_slice::<serde::de::IgnoredAny>(&bytes).map_err(|e| {
+        ErrorReply::new(
+            ErrorCode::MalformedJson,
+            format!("payload is not valid JSON: {e}"),
+        )
+    })?;
     Ok(bytes)
 }
 
-fn worker_loop(mut plugin: PluginInstance, name: String, jobs: mpsc::Receiver<Job>, current: Arc<Mutex<CurrentCall>>) {
+fn worker_loop(
+    mut plugin: PluginInstance,
+    name: String,
+    jobs: mpsc::Receiver<Job>,
+    current: Arc<Mutex<CurrentCall>>,
+) {
     while let Ok(job) = jobs.recv() {
         let cancel = Arc::new(AtomicBool::new(false));
         {
@@ -145,7 +174,9 @@ impl RunningHost {
                     library.info().roles
                 );
             }
-            if libraries.iter().any(|(e, _): &(&crate::config::PluginEntryConfig, LoadedLibrary)| e.role == entry.role) {
+            if libraries.iter().any(
+                |(e, _): &(&crate::config::PluginEntryConfig, LoadedLibrary)| e.role == entry.role,
+            ) {
                 bail!("two plugins are configured for role `{}`", entry.role);
             }
             libraries.push((entry, library));
@@ -167,12 +198,24 @@ impl RunningHost {
         for (entry, library) in libraries {
             let info = library.info().clone();
             let progress_key = keys.progress(&entry.role);
-            let bus_host = BusHost::new(session.clone(), keys.clone(), progress_key, info.name.clone());
-            let plugin_config = entry.config.as_ref().map(|t| t.to_string()).unwrap_or_default();
+            let bus_host = BusHost::new(
+                session.clone(),
+                keys.clone(),
+                progress_key,
+                info.name.clone(),
+            );
+            let plugin_config = entry
+                .config
+                .as_ref()
+                .map(|t| t.to_string())
+                .unwrap_or_default();
             let instance = library.create(bus_host.into_ffi(), &plugin_config)?;
             let (queue, jobs) = mpsc::channel();
             let current = Arc::new(Mutex::new(CurrentCall::default()));
-            let worker = Worker { queue, current: current.clone() };
+            let worker = Worker {
+                queue,
+                current: current.clone(),
+            };
             let name = info.name.clone();
             host.workers.push(
                 std::thread::Builder::new()
@@ -180,8 +223,20 @@ impl RunningHost {
                     .spawn(move || worker_loop(instance, name, jobs, current))
                     .context("spawning a plugin worker thread")?,
             );
-            host.queryables.push(Self::serve_role(&session, &keys, &entry.role, worker, config.limits.max_payload_bytes)?);
-            tracing::info!(plugin = info.name.as_str(), version = info.version.as_str(), role = entry.role.as_str(), "plugin loaded from {}", library.path().display());
+            host.queryables.push(Self::serve_role(
+                &session,
+                &keys,
+                &entry.role,
+                worker,
+                config.limits.max_payload_bytes,
+            )?);
+            tracing::info!(
+                plugin = info.name.as_str(),
+                version = info.version.as_str(),
+                role = entry.role.as_str(),
+                "plugin loaded from {}",
+                library.path().display()
+            );
             host.plugins.plugins.push(PluginEntry {
                 name: info.name,
                 version: info.version,
@@ -201,15 +256,30 @@ impl RunningHost {
         Ok(host)
     }
 
-    fn serve_role(session: &zenoh::Session, keys: &KeySpace, role: &str, worker: Worker, max_bytes: usize) -> Result<Queryable<()>> {
+    fn serve_role(
+        session: &zenoh::Session,
+        keys: &KeySpace,
+        role: &str,
+        worker: Worker,
+        max_bytes: usize,
+    ) -> Result<Queryable<()>> {
         let wildcard = keys.role_wildcard(role);
         let role_keys = keys.clone();
         let role_name = role.to_owned();
         session
             .declare_queryable(&wildcard)
             .callback(move |query| {
-                let Some(command) = role_keys.command_of(&role_name, query.key_expr().as_str()).map(str::to_owned) else {
-                    return reply_error(&query, ErrorReply::new(ErrorCode::UnknownCommand, format!("no command in key {}", query.key_expr())));
+                let Some(command) = role_keys
+                    .command_of(&role_name, query.key_expr().as_str())
+                    .map(str::to_owned)
+                else {
+                    return reply_error(
+                        &query,
+                        ErrorReply::new(
+                            ErrorCode::UnknownCommand,
+                            format!("no command in key {}", query.key_expr()),
+                        ),
+                    );
                 };
                 if command == keys::STOP {
                     let reply = worker.stop();
@@ -217,7 +287,15 @@ impl RunningHost {
                 }
                 match checked_payload(&query, max_bytes) {
                     Ok(payload) => {
-                        if worker.queue.send(Job { command, payload, query }).is_err() {
+                        if worker
+                            .queue
+                            .send(Job {
+                                command,
+                                payload,
+                                query,
+                            })
+                            .is_err()
+                        {
                             tracing::error!("worker of role {role_name} has stopped");
                         }
                     }

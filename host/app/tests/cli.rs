@@ -9,7 +9,10 @@ fn repo() -> PathBuf {
 }
 
 fn humanoid() -> String {
-    repo().join("models/robots/tsukami_humanoid/tsukami_humanoid.urdf").display().to_string()
+    repo()
+        .join("models/robots/tsukami_humanoid/tsukami_humanoid.urdf")
+        .display()
+        .to_string()
 }
 
 fn tsukami(args: &[&str], stdin: Option<&str>) -> Output {
@@ -28,7 +31,11 @@ fn tsukami(args: &[&str], stdin: Option<&str>) -> Output {
 }
 
 fn json(out: &Output) -> serde_json::Value {
-    assert!(out.status.success(), "failed: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -36,20 +43,41 @@ fn json(out: &Output) -> serde_json::Value {
 fn model_inspect_lists_links_and_joints_with_mimics() {
     let report = json(&tsukami(&["model", "inspect", &humanoid()], None));
     let joints = report["joints"].as_array().unwrap();
-    let j4 = joints.iter().find(|j| j["name"] == "r_index_j4").expect("r_index_j4");
+    let j4 = joints
+        .iter()
+        .find(|j| j["name"] == "r_index_j4")
+        .expect("r_index_j4");
     assert_eq!(j4["mimic"]["joint"], "r_index_j3");
-    for field in ["type", "parent", "child", "lower", "upper", "effort", "velocity"] {
+    for field in [
+        "type", "parent", "child", "lower", "upper", "effort", "velocity",
+    ] {
         assert!(j4.get(field).is_some(), "joint field {field} missing");
     }
-    assert!(report["links"].as_array().unwrap().iter().any(|l| l["name"] == "r_palm" && l["mass"].is_number()));
+    assert!(report["links"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|l| l["name"] == "r_palm" && l["mass"].is_number()));
 }
 
 #[test]
 fn model_fk_single_and_batch_agree() {
-    let single = json(&tsukami(&["model", "fk", &humanoid(), "--joint", "r_elbow=-0.8"], None));
+    let single = json(&tsukami(
+        &["model", "fk", &humanoid(), "--joint", "r_elbow=-0.8"],
+        None,
+    ));
     let batch_file = std::env::temp_dir().join(format!("tsukami-fk-{}.json", std::process::id()));
     std::fs::write(&batch_file, r#"[{}, {"r_elbow": -0.8}]"#).unwrap();
-    let batch = json(&tsukami(&["model", "fk", &humanoid(), "--batch", batch_file.to_str().unwrap()], None));
+    let batch = json(&tsukami(
+        &[
+            "model",
+            "fk",
+            &humanoid(),
+            "--batch",
+            batch_file.to_str().unwrap(),
+        ],
+        None,
+    ));
     assert_eq!(batch.as_array().unwrap().len(), 2);
     assert_eq!(batch[1]["links"]["r_palm"], single["links"]["r_palm"]);
     assert_ne!(batch[0]["links"]["r_palm"], single["links"]["r_palm"]);
@@ -57,7 +85,10 @@ fn model_fk_single_and_batch_agree() {
 
 #[test]
 fn model_fk_refuses_a_mimic_joint_and_an_unknown_one() {
-    for (joint, needle) in [("r_index_j4=0.1", "mimic"), ("elbow_of_nobody=1", "elbow_of_nobody")] {
+    for (joint, needle) in [
+        ("r_index_j4=0.1", "mimic"),
+        ("elbow_of_nobody=1", "elbow_of_nobody"),
+    ] {
         let out = tsukami(&["model", "fk", &humanoid(), "--joint", joint], None);
         assert!(!out.status.success());
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -69,12 +100,51 @@ fn model_fk_refuses_a_mimic_joint_and_an_unknown_one() {
 fn model_ik_reaches_a_pose_the_arm_can_reach() {
     let arm = "r_shoulder_pitch,r_shoulder_roll,r_shoulder_yaw,r_elbow,r_wrist_yaw,r_wrist_pitch,r_wrist_roll";
     // A target made from a known configuration is reachable by construction.
-    let fk = json(&tsukami(&["model", "fk", &humanoid(), "--joint", "r_elbow=-1.0", "--joint", "r_shoulder_pitch=-0.4"], None));
+    let fk = json(&tsukami(
+        &[
+            "model",
+            "fk",
+            &humanoid(),
+            "--joint",
+            "r_elbow=-1.0",
+            "--joint",
+            "r_shoulder_pitch=-0.4",
+        ],
+        None,
+    ));
     let palm = &fk["links"]["r_palm"];
-    let p: Vec<f64> = palm["position"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-    let q: Vec<f64> = palm["quaternion"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-    let target = format!("{},{},{},{},{},{},{}", p[0], p[1], p[2], q[0], q[1], q[2], q[3]);
-    let ik = json(&tsukami(&["model", "ik", &humanoid(), "--link", "r_palm", "--target", &target, "--joints", arm, "--seed", "3"], None));
+    let p: Vec<f64> = palm["position"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let q: Vec<f64> = palm["quaternion"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let target = format!(
+        "{},{},{},{},{},{},{}",
+        p[0], p[1], p[2], q[0], q[1], q[2], q[3]
+    );
+    let ik = json(&tsukami(
+        &[
+            "model",
+            "ik",
+            &humanoid(),
+            "--link",
+            "r_palm",
+            "--target",
+            &target,
+            "--joints",
+            arm,
+            "--seed",
+            "3",
+        ],
+        None,
+    ));
     assert_eq!(ik["ok"], true, "{ik}");
     assert!(ik["position_error"].as_f64().unwrap() < 1e-3);
     assert_eq!(ik["joint_positions"].as_object().unwrap().len(), 7);
@@ -94,10 +164,25 @@ fn fc_answers_every_problem_and_names_the_bad_one() {
     let results = json(&tsukami(&["fc"], Some(problems)));
     let results = results.as_array().unwrap();
     assert_eq!(results.len(), 2);
-    assert!(results[0]["ellipsoid"]["margin"].is_number(), "{}", results[0]);
-    assert_eq!(results[0]["exact"]["resists_weight"], true, "{}", results[0]);
+    assert!(
+        results[0]["ellipsoid"]["margin"].is_number(),
+        "{}",
+        results[0]
+    );
+    assert_eq!(
+        results[0]["exact"]["resists_weight"], true,
+        "{}",
+        results[0]
+    );
     assert_eq!(results[1]["error"]["index"], 1, "{}", results[1]);
-    assert!(results[1]["error"]["field"].as_str().unwrap().contains("contacts"), "{}", results[1]);
+    assert!(
+        results[1]["error"]["field"]
+            .as_str()
+            .unwrap()
+            .contains("contacts"),
+        "{}",
+        results[1]
+    );
 }
 
 #[test]
@@ -110,7 +195,11 @@ fn schema_command_writes_what_is_committed() {
     for entry in std::fs::read_dir(&out_dir).unwrap() {
         let path = entry.unwrap().path();
         let name = path.file_name().unwrap();
-        assert_eq!(std::fs::read_to_string(&path).unwrap(), std::fs::read_to_string(committed.join(name)).unwrap_or_default(), "{name:?} differs");
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            std::fs::read_to_string(committed.join(name)).unwrap_or_default(),
+            "{name:?} differs"
+        );
         count += 1;
     }
     assert!(count >= 10);

@@ -3,6 +3,10 @@
 //! with p99 and success rate printed), and hand-link distance queries
 //! against the 350 ml can mesh (< 5 µs) and a 100k-triangle mesh (< 50 µs).
 //!
+//! The distance benchmarks run twice, with the closed-form capsule-vs-mesh
+//! path (`DistanceMethod::Fast`, the default, plain names) and with parry's
+//! general path (`parry/…`), and print the ratio measured in the same run.
+//!
 //! `cargo bench -p tsukami-body -- --warm-up-time 1 --measurement-time 3`
 
 use std::hint::black_box;
@@ -13,7 +17,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::{Isometry3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tsukami_body::collision::{CollisionObject, RobotCollision};
+use tsukami_body::collision::{CollisionObject, DistanceMethod, RobotCollision};
 use tsukami_body::ik::{IkOptions, IkSolver, RIGHT_ARM};
 use tsukami_body::kinematics::{FkState, JointSelection};
 use tsukami_body::mesh::TriangleMesh;
@@ -94,9 +98,50 @@ fn bench_ik(c: &mut Criterion) {
     });
 }
 
+/// Mean time of one call (µs) over interleaved batches, the best of 7.
+fn mean_us(mut f: impl FnMut()) -> f64 {
+    let batch = 2000;
+    let mut best = f64::INFINITY;
+    for _ in 0..7 {
+        let start = Instant::now();
+        for _ in 0..batch {
+            f();
+        }
+        best = best.min(start.elapsed().as_secs_f64() * 1e6 / batch as f64);
+    }
+    best
+}
+
+/// Benchmarks `query` with the fast path (`name`) and parry's (`parry/name`)
+/// and prints their ratio.
+fn both_paths<T>(
+    c: &mut Criterion,
+    name: &str,
+    fast: &RobotCollision,
+    parry: &RobotCollision,
+    query: impl Fn(&RobotCollision) -> T,
+) {
+    let t_parry = mean_us(|| {
+        black_box(query(black_box(parry)));
+    });
+    let t_fast = mean_us(|| {
+        black_box(query(black_box(fast)));
+    });
+    println!(
+        "{name}: parry {t_parry:.2} µs, fast {t_fast:.2} µs, ratio {:.1}x",
+        t_parry / t_fast
+    );
+    c.bench_function(name, |b| b.iter(|| black_box(query(fast))));
+    c.bench_function(&format!("parry/{name}"), |b| {
+        b.iter(|| black_box(query(parry)))
+    });
+}
+
 fn bench_distance(c: &mut Criterion) {
     let m = humanoid();
     let coll = RobotCollision::new(&m).unwrap();
+    let mut parry = coll.clone();
+    parry.set_distance_method(DistanceMethod::Parry);
     let mut fk = FkState::new(&m);
     m.forward_kinematics(&m.rest_positions(), &mut fk);
     let tip = m.link_id("r_index_l4").unwrap();
@@ -106,85 +151,54 @@ fn bench_distance(c: &mut Criterion) {
         Vector3::repeat(1.0),
     )
     .unwrap();
-    // The can 2 cm beside the fingertip.
-    let can_obj = CollisionObject::from_mesh(
-        "can",
-        Isometry3::translation(tip_p.x, tip_p.y + 0.0085 + 0.02 + 0.033, tip_p.z - 0.061),
-        &can,
-    )
-    .unwrap();
-    c.bench_function(
-        &format!("distance_fingertip_vs_can_{}_tris", can.indices.len()),
-        |b| {
-            b.iter(|| {
-                black_box(
-                    coll.link_object_proximity(&fk, tip, &can_obj, 1.0)
-                        .map(|p| p.distance),
-                )
-            })
-        },
-    );
-    let palm = m.link_id("r_palm").unwrap();
-    c.bench_function("distance_palm_vs_can", |b| {
-        b.iter(|| {
-            black_box(
-                coll.link_object_proximity(&fk, palm, &can_obj, 1.0)
-                    .map(|p| p.distance),
-            )
-        })
-    });
+    let at = |gap: f64, radius: f64, dz: f64| {
+        Isometry3::translation(tip_p.x, tip_p.y + 0.0085 + gap + radius, tip_p.z + dz)
+    };
+    // The can 2 cm beside the fingertip, and 2 mm (the finger-closing loop).
+    let can_obj = CollisionObject::from_mesh("can", at(0.02, 0.033, -0.061), &can).unwrap();
+    let near_can = CollisionObject::from_mesh("can", at(0.002, 0.033, -0.061), &can).unwrap();
     // A 100k-triangle closed mesh (a finely tessellated 10 cm sphere).
     let big = TriangleMesh::uv_sphere(0.1, 224, 224);
-    let big_obj = CollisionObject::from_mesh(
-        "sphere100k",
-        Isometry3::translation(tip_p.x, tip_p.y + 0.0085 + 0.02 + 0.1, tip_p.z),
-        &big,
-    )
-    .unwrap();
-    c.bench_function(
-        &format!("distance_fingertip_vs_{}_tris", big.indices.len()),
-        |b| {
-            b.iter(|| {
-                black_box(
-                    coll.link_object_proximity(&fk, tip, &big_obj, 1.0)
-                        .map(|p| p.distance),
-                )
-            })
-        },
-    );
-    // The regime of the finger-closing loop: the link 2 mm from the surface.
-    let near_can = CollisionObject::from_mesh(
-        "can",
-        Isometry3::translation(tip_p.x, tip_p.y + 0.0085 + 0.002 + 0.033, tip_p.z - 0.061),
-        &can,
-    )
-    .unwrap();
-    c.bench_function("distance_fingertip_vs_can_at_2mm", |b| {
-        b.iter(|| {
-            black_box(
-                coll.link_object_proximity(&fk, tip, &near_can, 1.0)
-                    .map(|p| p.distance),
-            )
-        })
-    });
-    let near_big = CollisionObject::from_mesh(
-        "sphere100k",
-        Isometry3::translation(tip_p.x, tip_p.y + 0.0085 + 0.002 + 0.1, tip_p.z),
-        &big,
-    )
-    .unwrap();
-    c.bench_function("distance_fingertip_vs_100k_tris_at_2mm", |b| {
-        b.iter(|| {
-            black_box(
-                coll.link_object_proximity(&fk, tip, &near_big, 1.0)
-                    .map(|p| p.distance),
-            )
-        })
-    });
+    let big_obj = CollisionObject::from_mesh("sphere100k", at(0.02, 0.1, 0.0), &big).unwrap();
+    let near_big = CollisionObject::from_mesh("sphere100k", at(0.002, 0.1, 0.0), &big).unwrap();
+    let palm = m.link_id("r_palm").unwrap();
+    let distance = |link: usize, object: &CollisionObject| {
+        let fk = &fk;
+        let object = object.clone();
+        move |c: &RobotCollision| {
+            c.link_object_proximity(fk, link, &object, 1.0)
+                .map(|p| p.distance)
+        }
+    };
+    let cases: Vec<(String, usize, &CollisionObject)> = vec![
+        (
+            format!("distance_fingertip_vs_can_{}_tris", can.indices.len()),
+            tip,
+            &can_obj,
+        ),
+        ("distance_palm_vs_can".into(), palm, &can_obj),
+        (
+            format!("distance_fingertip_vs_{}_tris", big.indices.len()),
+            tip,
+            &big_obj,
+        ),
+        ("distance_fingertip_vs_can_at_2mm".into(), tip, &near_can),
+        (
+            "distance_fingertip_vs_100k_tris_at_2mm".into(),
+            tip,
+            &near_big,
+        ),
+    ];
+    for (name, link, object) in cases {
+        both_paths(c, &name, &coll, &parry, distance(link, object));
+    }
     let hand: Vec<usize> = (palm..m.links.len()).collect();
-    c.bench_function(
+    both_paths(
+        c,
         &format!("collision_hand_{}_links_vs_can", hand.len()),
-        |b| b.iter(|| black_box(coll.first_collision(&fk, &hand, &[&can_obj], 0.005))),
+        &coll,
+        &parry,
+        |c| c.first_collision(&fk, &hand, &[&can_obj], 0.005),
     );
     c.bench_function("self_collision_humanoid", |b| {
         b.iter(|| black_box(coll.first_self_collision(&fk, 0.0)))

@@ -19,12 +19,24 @@
 //! and reports a collision (a negative distance, see [`Proximity`]) if so.
 //! Open meshes stay surfaces; callers that need solids should refuse them
 //! ([`CollisionObject::is_solid`]).
+//!
+//! # Narrow phase
+//! A link part that is a ball or a capsule (the finger phalanges) against an
+//! object part that is a mesh is answered by the closed-form path of
+//! [`crate::capsule_mesh`]; every other pair (boxes — palms, first
+//! phalanges — included), and the penetration depth of overlapping pairs,
+//! by parry's general queries. The
+//! paths agree (the capsule path is exact where parry's GJK stops at its
+//! tolerance, see `tests/fast_distance.rs`);
+//! [`RobotCollision::set_distance_method`] selects parry's path for
+//! everything (the reference, for tests and benchmarks).
 
 use nalgebra::{Isometry3, Point3, Unit, UnitQuaternion, Vector3};
 use parry3d_f64::math::Pose;
 use parry3d_f64::query::{self, ClosestPoints};
 use parry3d_f64::shape::{SharedShape, TriMesh, TriMeshFlags};
 
+use crate::capsule_mesh::{self, MeshClosestPoints, SweptSphere};
 use crate::convert::{from_pose, to_point, to_pose, to_vec, to_vector};
 use crate::error::{BodyError, Result};
 use crate::kinematics::FkState;
@@ -201,9 +213,65 @@ pub struct Proximity {
 /// Signed distance, witness points (link, object) and object normal.
 type PairProximity = (f64, Point3<f64>, Point3<f64>, Unit<Vector3<f64>>);
 
+/// Which narrow phase answers the queries of a [`RobotCollision`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DistanceMethod {
+    /// The closed-form ball/capsule-vs-mesh path where it applies
+    /// ([`crate::capsule_mesh`]), parry's general queries elsewhere.
+    #[default]
+    Fast,
+    /// parry's general queries for every pair: the reference.
+    Parry,
+}
+
+/// Closest points of two placed shapes (world poses `w1`, `w2`) by the fast
+/// paths, in parry's conventions (world frame); `None` when no fast path
+/// applies to the pair: `p2` is not a mesh, `p1` neither a ball nor a
+/// capsule, or `method` is parry's.
+fn fast_closest_points(
+    method: DistanceMethod,
+    w1: &Pose,
+    p1: &Part,
+    w2: &Pose,
+    p2: &Part,
+    max_distance: f64,
+) -> Option<ClosestPoints> {
+    if method != DistanceMethod::Fast {
+        return None;
+    }
+    let mesh = p2.shape.as_trimesh()?;
+    // The link part in the mesh's frame.
+    let pose = w2.inv_mul(w1);
+    let sphere = SweptSphere::from_shape(&*p1.shape)?.transformed(&pose);
+    Some(
+        match capsule_mesh::closest_points_to_trimesh(mesh, &sphere, max_distance) {
+            MeshClosestPoints::Separated {
+                on_sphere, on_mesh, ..
+            } => ClosestPoints::WithinMargin(*w2 * on_sphere, *w2 * on_mesh),
+            MeshClosestPoints::Intersecting => ClosestPoints::Intersecting,
+            MeshClosestPoints::Disjoint => ClosestPoints::Disjoint,
+        },
+    )
+}
+
+/// Closest points of two placed shapes (world poses `w1`, `w2`), with
+/// parry's conventions.
+fn closest_points(
+    method: DistanceMethod,
+    w1: &Pose,
+    p1: &Part,
+    w2: &Pose,
+    p2: &Part,
+    max_distance: f64,
+) -> Option<ClosestPoints> {
+    fast_closest_points(method, w1, p1, w2, p2, max_distance)
+        .or_else(|| query::closest_points(w1, &*p1.shape, w2, &*p2.shape, max_distance).ok())
+}
+
 /// Proximity between two placed shapes, or `None` if farther than
 /// `max_distance`.
 fn pair_proximity(
+    method: DistanceMethod,
     pose1: &Pose,
     p1: &Part,
     pose2: &Pose,
@@ -212,7 +280,7 @@ fn pair_proximity(
 ) -> Option<PairProximity> {
     let w1 = *pose1 * p1.origin;
     let w2 = *pose2 * p2.origin;
-    let cp = query::closest_points(&w1, &*p1.shape, &w2, &*p2.shape, max_distance).ok()?;
+    let cp = closest_points(method, &w1, p1, &w2, p2, max_distance)?;
     match cp {
         ClosestPoints::WithinMargin(a, b) => {
             let d = (a - b).length();
@@ -260,13 +328,23 @@ fn aabbs_overlap(pose1: &Pose, p1: &Part, pose2: &Pose, p2: &Part, margin: f64) 
 
 /// Do two placed parts collide, i.e. come closer than `margin` (or overlap,
 /// or one lies inside the other's closed mesh)?
-fn pair_collides(pose1: &Pose, p1: &Part, pose2: &Pose, p2: &Part, margin: f64) -> bool {
+fn pair_collides(
+    method: DistanceMethod,
+    pose1: &Pose,
+    p1: &Part,
+    pose2: &Pose,
+    p2: &Part,
+    margin: f64,
+) -> bool {
     if !aabbs_overlap(pose1, p1, pose2, p2, margin) {
         return false;
     }
     let w1 = *pose1 * p1.origin;
     let w2 = *pose2 * p2.origin;
-    let hit = if margin > 0.0 {
+    let hit = if let Some(cp) = fast_closest_points(method, &w1, p1, &w2, p2, margin.max(0.0)) {
+        // Margin 0 accepts only overlaps, like parry's intersection test.
+        !matches!(cp, ClosestPoints::Disjoint)
+    } else if margin > 0.0 {
         !matches!(
             query::closest_points(&w1, &*p1.shape, &w2, &*p2.shape, margin),
             Ok(ClosestPoints::Disjoint)
@@ -308,6 +386,7 @@ pub struct RobotCollision {
     n: usize,
     /// Links with geometry, for self-collision loops.
     with_geometry: Vec<LinkId>,
+    method: DistanceMethod,
 }
 
 impl RobotCollision {
@@ -332,6 +411,7 @@ impl RobotCollision {
             allowed: vec![false; n * n],
             n,
             with_geometry,
+            method: DistanceMethod::Fast,
         };
         for l in 0..n {
             me.allow(l, l);
@@ -356,6 +436,17 @@ impl RobotCollision {
             }
         }
         Ok(me)
+    }
+
+    /// Selects the narrow phase of every query (default
+    /// [`DistanceMethod::Fast`]; [`DistanceMethod::Parry`] is the reference).
+    pub fn set_distance_method(&mut self, method: DistanceMethod) {
+        self.method = method;
+    }
+
+    /// The narrow phase in use.
+    pub fn distance_method(&self) -> DistanceMethod {
+        self.method
     }
 
     /// Never check the pair `(a, b)` for self-collision.
@@ -396,9 +487,14 @@ impl RobotCollision {
         for (i, lp) in self.parts[link].iter().enumerate() {
             for (k, op) in object.parts.iter().enumerate() {
                 let limit = best.map_or(max_distance, |b| b.distance.min(max_distance));
-                if let Some((d, a, b, n)) =
-                    pair_proximity(&link_pose, lp, &object.parry_pose, op, limit.max(0.0))
-                {
+                if let Some((d, a, b, n)) = pair_proximity(
+                    self.method,
+                    &link_pose,
+                    lp,
+                    &object.parry_pose,
+                    op,
+                    limit.max(0.0),
+                ) {
                     if best.is_none_or(|bb| d < bb.distance) {
                         best = Some(Proximity {
                             distance: d,
@@ -429,7 +525,14 @@ impl RobotCollision {
             for (o, object) in objects.iter().enumerate() {
                 for lp in &self.parts[link] {
                     for op in &object.parts {
-                        if pair_collides(&link_pose, lp, &object.parry_pose, op, margin) {
+                        if pair_collides(
+                            self.method,
+                            &link_pose,
+                            lp,
+                            &object.parry_pose,
+                            op,
+                            margin,
+                        ) {
                             return Some(Hit { link, object: o });
                         }
                     }
@@ -470,7 +573,7 @@ impl RobotCollision {
                 let hit = self.parts[a].iter().any(|x| {
                     self.parts[b]
                         .iter()
-                        .any(|y| pair_collides(&pa, x, &pb, y, margin))
+                        .any(|y| pair_collides(self.method, &pa, x, &pb, y, margin))
                 });
                 if hit {
                     out.push((a, b));

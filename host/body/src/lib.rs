@@ -21,9 +21,11 @@
 //!
 //! Modules, lowest first: [`mesh`] (triangle meshes), [`model`] and [`urdf`]
 //! (the kinematic tree), [`kinematics`] (FK, Jacobians), [`ik`],
-//! [`collision`], [`shape_spec`], [`object`] and [`scene`] (TOML files), and
+//! [`collision`] (with its fast narrow phase [`capsule_mesh`]),
+//! [`shape_spec`], [`object`] and [`scene`] (TOML files), and
 //! [`report`] (what the `tsukami model` commands print).
 
+pub mod capsule_mesh;
 pub mod collision;
 pub mod convert;
 pub mod error;

@@ -11,21 +11,39 @@ use std::time::Instant;
 use common::Sweep;
 
 fn main() {
-    let cases: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(5000);
+    let cases: usize = std::env::args()
+        .nth(1)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(5000);
     let counts = [3, 4, 5, 6];
     let t0 = Instant::now();
-    let s = common::sweep(cases, 0x5453_554b_414d_49, &counts, 8, 50);
+    let s = common::sweep(cases, 0x0054_5355_4b41_4d49, &counts, 8, 50);
     println!("{} grasps ({} per shape, can and box), 3–6 contacts, μ in [0.2, 1], f_max 10 N, 8-sided pyramids, seed fixed; {:.1} s", 2 * cases, cases, t0.elapsed().as_secs_f64());
     println!();
-    println!("exact (8-pyramid) vs Ferrari–Canny eps_L1 > 0:   {}", s.exact_vs_l1);
-    println!("exact (8-pyramid) vs Ferrari–Canny eps_Linf > 0: {}", s.exact_vs_linf);
-    println!("exact 8-pyramid vs exact circular cone:          {}", s.poly_vs_circular);
+    println!(
+        "exact (8-pyramid) vs Ferrari–Canny eps_L1 > 0:   {}",
+        s.exact_vs_l1
+    );
+    println!(
+        "exact (8-pyramid) vs Ferrari–Canny eps_Linf > 0: {}",
+        s.exact_vs_linf
+    );
+    println!(
+        "exact 8-pyramid vs exact circular cone:          {}",
+        s.poly_vs_circular
+    );
     println!();
     println!("ellipsoid vs exact (circular cone), alpha = 1/sqrt(2), inscribed centre:");
     println!("  force closure, delta_f = 0:     {}", s.ellipsoid_closure);
-    println!("  force closure, delta_f = n - 1: {}", s.ellipsoid_closure_inner);
+    println!(
+        "  force closure, delta_f = n - 1: {}",
+        s.ellipsoid_closure_inner
+    );
     println!("  weight,        delta_f = 0:     {}", s.ellipsoid_weight);
-    println!("  weight,        delta_f = n - 1: {}", s.ellipsoid_weight_inner);
+    println!(
+        "  weight,        delta_f = n - 1: {}",
+        s.ellipsoid_weight_inner
+    );
     println!();
     println!("delta_f giving zero false positives (a grasp passes when margin > delta_f):");
     println!("  contacts | closure delta_f | closure FN at it | weight delta_f | weight FN at it");

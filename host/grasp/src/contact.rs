@@ -132,7 +132,10 @@ mod tests {
         for n in normals {
             let c = Contact::new(Point3::origin(), n).unwrap();
             let u = c.frame();
-            assert!((u.transpose() * u - Matrix3::identity()).norm() < 1e-12, "{n}");
+            assert!(
+                (u.transpose() * u - Matrix3::identity()).norm() < 1e-12,
+                "{n}"
+            );
             assert!((u.determinant() - 1.0).abs() < 1e-12, "{n}");
             assert!((u.column(2) - n).norm() < 1e-12);
         }

@@ -269,7 +269,12 @@ fn contact_terms(
 }
 
 /// Evaluates `(d₀ᵀ M⁻¹ d₀, d₁ᵀ M⁻¹ d₁)` with `d₀ = −w0`, `d₁ = w − w0`.
-fn evaluate(m: Matrix6<f64>, w0: &Vector6<f64>, w: &Vector6<f64>, contacts: usize) -> EllipsoidTest {
+fn evaluate(
+    m: Matrix6<f64>,
+    w0: &Vector6<f64>,
+    w: &Vector6<f64>,
+    contacts: usize,
+) -> EllipsoidTest {
     let d0 = -w0;
     let d1 = w - w0;
     let diag = m.diagonal();
@@ -278,8 +283,12 @@ fn evaluate(m: Matrix6<f64>, w0: &Vector6<f64>, w: &Vector6<f64>, contacts: usiz
         let regular = (0..6).all(|k| l[(k, k)] * l[(k, k)] > SINGULAR_PIVOT * diag[k]);
         if regular {
             // dᵀ M⁻¹ d = ‖L⁻¹ d‖².
-            let y0 = l.solve_lower_triangular(&d0).unwrap_or_else(|| Vector6::repeat(f64::INFINITY));
-            let y1 = l.solve_lower_triangular(&d1).unwrap_or_else(|| Vector6::repeat(f64::INFINITY));
+            let y0 = l
+                .solve_lower_triangular(&d0)
+                .unwrap_or_else(|| Vector6::repeat(f64::INFINITY));
+            let y1 = l
+                .solve_lower_triangular(&d1)
+                .unwrap_or_else(|| Vector6::repeat(f64::INFINITY));
             return EllipsoidTest {
                 closure_value: y0.norm_squared(),
                 wrench_value: y1.norm_squared(),
@@ -320,7 +329,7 @@ fn pseudo_quadratic(m: &Matrix6<f64>, d: &Vector6<f64>) -> f64 {
 
 /// Eq. (10) for `grasp` with one ellipsoid model on every contact, at `w = 0`
 /// (force closure) and at `w = −external` (holding against `external`, e.g.
-/// the weight wrench). Allocation-free; about 0.2 µs for four contacts.
+/// the weight wrench). Allocation-free; about 0.3 µs for four contacts.
 pub fn ellipsoid_test(grasp: &Grasp, model: &EllipsoidModel, external: &Wrench) -> EllipsoidTest {
     let mut m = Matrix6::zeros();
     let mut w0 = Vector6::zeros();
@@ -452,8 +461,13 @@ mod tests {
             for j in 0..33 {
                 let th = i as f64 / 64.0 * std::f64::consts::TAU;
                 let ph = j as f64 / 32.0 * std::f64::consts::PI;
-                let f = Vector3::new(a * ph.sin() * th.cos(), a * ph.sin() * th.sin(), centre + b * ph.cos());
-                let towards_centre = Vector3::new(0.0, 0.0, centre) + (f - Vector3::new(0.0, 0.0, centre)) * (1.0 - 1e-9);
+                let f = Vector3::new(
+                    a * ph.sin() * th.cos(),
+                    a * ph.sin() * th.sin(),
+                    centre + b * ph.cos(),
+                );
+                let towards_centre = Vector3::new(0.0, 0.0, centre)
+                    + (f - Vector3::new(0.0, 0.0, centre)) * (1.0 - 1e-9);
                 assert!(model.contains(&c, mu, f_max, &towards_centre));
                 assert!(f.xy().norm() <= mu * f.z + 1e-9, "outside the cone at {f}");
                 assert!(f.z <= f_max + 1e-9);
@@ -463,7 +477,11 @@ mod tests {
         let fat = EllipsoidModel::inscribed(0.9);
         let (centre, a, b) = fat.axes(mu, f_max);
         let z = -1.0 / (1.0 + 1.0 / (2.0 * 0.81)); // the tangency height for α = 0.9
-        let f = Vector3::new(a * (1.0 - z * z * centre * centre / (b * b)).sqrt(), 0.0, centre * (1.0 + z));
+        let f = Vector3::new(
+            a * (1.0 - z * z * centre * centre / (b * b)).sqrt(),
+            0.0,
+            centre * (1.0 + z),
+        );
         assert!(f.xy().norm() > mu * f.z);
     }
 

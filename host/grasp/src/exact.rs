@@ -53,9 +53,7 @@
 //! iterations (see the bench `force_closure`).
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{
-    DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
-};
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use nalgebra::{Matrix6, SymmetricEigen, Vector3};
 
 use crate::grasp::Grasp;
@@ -144,7 +142,9 @@ pub fn grasp_rank(grasp: &Grasp) -> usize {
     }
     let eig = SymmetricEigen::new(ggt).eigenvalues;
     let largest = eig.max();
-    eig.iter().filter(|&&l| l > RANK_TOLERANCE * largest).count()
+    eig.iter()
+        .filter(|&&l| l > RANK_TOLERANCE * largest)
+        .count()
 }
 
 /// Which extra scalar variable the program maximises.
@@ -165,7 +165,12 @@ fn solve(grasp: &Grasp, cone: ConeModel, extra: Extra<'_>) -> Result<(Vec<f64>, 
     let mut b = Vec::new();
     let mut cones = Vec::new();
     let mut row = 0;
-    let push = |r: usize, c: usize, v: f64, ri: &mut Vec<usize>, ci: &mut Vec<usize>, vals: &mut Vec<f64>| {
+    let push = |r: usize,
+                c: usize,
+                v: f64,
+                ri: &mut Vec<usize>,
+                ci: &mut Vec<usize>,
+                vals: &mut Vec<f64>| {
         if v != 0.0 {
             ri.push(r);
             ci.push(c);
@@ -266,7 +271,11 @@ fn solve(grasp: &Grasp, cone: ConeModel, extra: Extra<'_>) -> Result<(Vec<f64>, 
 pub fn exact_force_closure(grasp: &Grasp, cone: ConeModel) -> Result<ExactClosure, ExactError> {
     let grasp_rank = grasp_rank(grasp);
     let (_, tau) = solve(grasp, cone, Extra::Squeeze)?;
-    let f_min = grasp.force_limits().iter().copied().fold(f64::INFINITY, f64::min);
+    let f_min = grasp
+        .force_limits()
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
     let force_closure = grasp_rank == 6 && tau > SQUEEZE_TOLERANCE * grasp.mu() * f_min;
     Ok(ExactClosure {
         force_closure,
@@ -277,7 +286,11 @@ pub fn exact_force_closure(grasp: &Grasp, cone: ConeModel) -> Result<ExactClosur
 
 /// The largest multiple of `external` (e.g. the weight wrench) the grasp can
 /// balance with cone model `cone`, and the world-frame contact forces doing it.
-pub fn exact_weight_scale(grasp: &Grasp, cone: ConeModel, external: &Wrench) -> Result<ExactWeight, ExactError> {
+pub fn exact_weight_scale(
+    grasp: &Grasp,
+    cone: ConeModel,
+    external: &Wrench,
+) -> Result<ExactWeight, ExactError> {
     if !external.iter().all(|x| x.is_finite()) {
         return Err(ExactError::BadWrench);
     }
@@ -295,7 +308,11 @@ pub fn exact_weight_scale(grasp: &Grasp, cone: ConeModel, external: &Wrench) -> 
 }
 
 /// Both exact programs for one grasp.
-pub fn exact_test(grasp: &Grasp, cone: ConeModel, external: &Wrench) -> Result<ExactTest, ExactError> {
+pub fn exact_test(
+    grasp: &Grasp,
+    cone: ConeModel,
+    external: &Wrench,
+) -> Result<ExactTest, ExactError> {
     Ok(ExactTest {
         closure: exact_force_closure(grasp, cone)?,
         weight: exact_weight_scale(grasp, cone, external)?,

@@ -33,6 +33,7 @@
 use nalgebra::Vector6;
 use qhull::Qh;
 
+use crate::exact::grasp_rank;
 use crate::grasp::Grasp;
 use crate::grasp_matrix::{contact_block, Wrench};
 
@@ -46,7 +47,8 @@ pub const ZERO_TOLERANCE: f64 = 1e-9;
 pub struct FerrariCannyOptions {
     /// Edges of the polyhedral friction cone, `k ≥ 3`.
     pub sides: usize,
-    /// Largest candidate point set one L∞ hull may be asked to process.
+    /// Largest candidate point set one L∞ hull may be asked to process
+    /// (default 5,000: four contacts with 8-sided cones, a few seconds).
     pub max_points: usize,
 }
 
@@ -54,7 +56,7 @@ impl Default for FerrariCannyOptions {
     fn default() -> Self {
         Self {
             sides: 8,
-            max_points: 200_000,
+            max_points: 5_000,
         }
     }
 }
@@ -66,7 +68,9 @@ pub enum FerrariCannyError {
     #[error("a polyhedral friction cone needs at least 3 sides, got {0}")]
     TooFewSides(usize),
     /// The L∞ Minkowski sum grew past the point limit.
-    #[error("the L-infinity Minkowski sum needs a hull of {points} points, over the limit of {limit}")]
+    #[error(
+        "the L-infinity Minkowski sum needs a hull of {points} points, over the limit of {limit}"
+    )]
     TooManyPoints {
         /// Candidate points at the step that overflowed.
         points: usize,
@@ -107,7 +111,11 @@ pub fn primitive_wrenches(grasp: &Grasp, sides: usize) -> Result<Vec<Wrench>, Fe
 /// if Qhull cannot build a full-dimensional hull (flat or too few points).
 /// Negative when the origin is outside.
 fn hull_epsilon(points: &[Wrench]) -> Option<f64> {
-    let qh = build_hull(points)?;
+    build_hull(points).and_then(|qh| facet_epsilon(&qh, points))
+}
+
+/// Smallest facet distance from the origin of a built hull of `points`.
+fn facet_epsilon(qh: &Qh<'_>, points: &[Wrench]) -> Option<f64> {
     let mut eps = f64::INFINITY;
     for f in qh.facets() {
         // Qhull: normal·x + offset ≤ 0 inside, unit outward normal.
@@ -138,11 +146,19 @@ pub fn epsilon_l1(grasp: &Grasp, sides: usize) -> Result<f64, FerrariCannyError>
 
 /// ε of the L∞ grasp wrench space (eq. (7)), by Minkowski addition with
 /// pruning to hull vertices after each contact.
-pub fn epsilon_linf(grasp: &Grasp, options: &FerrariCannyOptions) -> Result<f64, FerrariCannyError> {
+pub fn epsilon_linf(
+    grasp: &Grasp,
+    options: &FerrariCannyOptions,
+) -> Result<f64, FerrariCannyError> {
     let k = options.sides;
     let w = primitive_wrenches(grasp, k)?;
+    if grasp_rank(grasp) < 6 {
+        // The whole sum is flat: no interior, and Qhull could not prune it.
+        return Ok(0.0);
+    }
     let mut set: Vec<Wrench> = vec![Vector6::zeros()];
-    for chunk in w.chunks(k) {
+    let contacts = grasp.len();
+    for (i, chunk) in w.chunks(k).enumerate() {
         let candidates = set.len() * (k + 1);
         if candidates > options.max_points {
             return Err(FerrariCannyError::TooManyPoints {
@@ -155,7 +171,13 @@ pub fn epsilon_linf(grasp: &Grasp, options: &FerrariCannyOptions) -> Result<f64,
             next.push(*v);
             next.extend(chunk.iter().map(|e| v + e));
         }
-        set = match build_hull(&next) {
+        let hull = build_hull(&next);
+        if i + 1 == contacts {
+            // ε from this hull itself: re-hulling its vertices can only lose precision.
+            let eps = hull.and_then(|qh| facet_epsilon(&qh, &next));
+            return Ok(eps.unwrap_or(0.0).max(0.0));
+        }
+        set = match hull {
             Some(qh) => qh
                 .vertices()
                 .filter_map(|v| v.index(&qh))
@@ -165,11 +187,15 @@ pub fn epsilon_linf(grasp: &Grasp, options: &FerrariCannyOptions) -> Result<f64,
             None => next,
         };
     }
-    Ok(hull_epsilon(&set).unwrap_or(0.0).max(0.0))
+    // A grasp has at least two contacts, so the loop returned.
+    Ok(0.0)
 }
 
 /// Both ε values with the given options.
-pub fn ferrari_canny(grasp: &Grasp, options: &FerrariCannyOptions) -> Result<FerrariCanny, FerrariCannyError> {
+pub fn ferrari_canny(
+    grasp: &Grasp,
+    options: &FerrariCannyOptions,
+) -> Result<FerrariCanny, FerrariCannyError> {
     Ok(FerrariCanny {
         epsilon_l1: epsilon_l1(grasp, options.sides)?,
         epsilon_linf: epsilon_linf(grasp, options)?,

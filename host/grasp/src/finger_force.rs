@@ -92,7 +92,11 @@ pub fn max_finger_force(
     {
         return Err(FingerForceError::BadEffort { joint, value });
     }
-    if !jacobian.iter().chain(direction.iter()).all(|x| x.is_finite()) {
+    if !jacobian
+        .iter()
+        .chain(direction.iter())
+        .all(|x| x.is_finite())
+    {
         return Err(FingerForceError::NonFinite);
     }
     // Joint torque per newton of normal force.
@@ -126,7 +130,8 @@ mod tests {
     fn two_link_planar_finger() {
         // Joints about z at the origin and at (0.04, 0, 0); contact at (0.07, 0, 0).
         // J columns: z × (p − o_j) = (0, 0.07, 0) and (0, 0.03, 0).
-        let j = Matrix3xX::from_columns(&[Vector3::new(0.0, 0.07, 0.0), Vector3::new(0.0, 0.03, 0.0)]);
+        let j =
+            Matrix3xX::from_columns(&[Vector3::new(0.0, 0.07, 0.0), Vector3::new(0.0, 0.03, 0.0)]);
         let tau = DVector::from_vec(vec![1.4, 0.3]);
         let f = max_finger_force(&j, &tau, &Vector3::y()).unwrap();
         // 1.4 / 0.07 = 20 N, 0.3 / 0.03 = 10 N: the distal joint limits.
@@ -146,14 +151,21 @@ mod tests {
         let j = Matrix3xX::from_columns(&[Vector3::new(0.0, 0.07, 0.0)]);
         assert!(matches!(
             max_finger_force(&j, &DVector::from_vec(vec![1.0, 2.0]), &Vector3::y()),
-            Err(FingerForceError::DimensionMismatch { columns: 1, limits: 2 })
+            Err(FingerForceError::DimensionMismatch {
+                columns: 1,
+                limits: 2
+            })
         ));
         assert!(matches!(
             max_finger_force(&j, &DVector::from_vec(vec![-1.0]), &Vector3::y()),
             Err(FingerForceError::BadEffort { joint: 0, .. })
         ));
         assert_eq!(
-            max_finger_force(&j, &DVector::from_vec(vec![1.0]), &Vector3::new(f64::NAN, 0.0, 0.0)),
+            max_finger_force(
+                &j,
+                &DVector::from_vec(vec![1.0]),
+                &Vector3::new(f64::NAN, 0.0, 0.0)
+            ),
             Err(FingerForceError::NonFinite)
         );
     }

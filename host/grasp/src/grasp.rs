@@ -164,7 +164,18 @@ impl Grasp {
 
     /// The wrench of the weight `mass · gravity` at `center_of_mass`, about
     /// this grasp's reference point with its torque scale.
-    pub fn weight_wrench(&self, mass: f64, gravity: &Vector3<f64>, center_of_mass: &Point3<f64>) -> Wrench {
-        weight_wrench(mass, gravity, center_of_mass, &self.reference, self.torque_scale)
+    pub fn weight_wrench(
+        &self,
+        mass: f64,
+        gravity: &Vector3<f64>,
+        center_of_mass: &Point3<f64>,
+    ) -> Wrench {
+        weight_wrench(
+            mass,
+            gravity,
+            center_of_mass,
+            &self.reference,
+            self.torque_scale,
+        )
     }
 }

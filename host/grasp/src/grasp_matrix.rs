@@ -22,7 +22,7 @@
 //! `G = [G_1 … G_n]` is 6×3n; methods that need speed never build it and sum
 //! the 6×6 or 6×1 contributions of each `G_i` instead.
 
-use nalgebra::{Matrix3, Matrix6x3, OMatrix, Point3, Vector3, Vector6, U6, Dyn};
+use nalgebra::{Dyn, Matrix3, Matrix6x3, OMatrix, Point3, Vector3, Vector6, U6};
 
 use crate::contact::Contact;
 
@@ -56,11 +56,19 @@ pub fn wrench(
 
 /// `G_i = [I; γ [p_i − r]×]`, the 6×3 block of contact `i` (world-frame force in).
 #[inline]
-pub fn contact_block(contact: &Contact, reference: &Point3<f64>, torque_scale: f64) -> Matrix6x3<f64> {
+pub fn contact_block(
+    contact: &Contact,
+    reference: &Point3<f64>,
+    torque_scale: f64,
+) -> Matrix6x3<f64> {
     let mut g = Matrix6x3::zeros();
-    g.fixed_view_mut::<3, 3>(0, 0).copy_from(&Matrix3::identity());
-    g.fixed_view_mut::<3, 3>(3, 0)
-        .copy_from(&torque_map(contact.position(), reference, torque_scale));
+    g.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&Matrix3::identity());
+    g.fixed_view_mut::<3, 3>(3, 0).copy_from(&torque_map(
+        contact.position(),
+        reference,
+        torque_scale,
+    ));
     g
 }
 
@@ -111,7 +119,13 @@ mod tests {
         let com = Point3::new(0.3, 0.1, 0.9);
         let w = weight_wrench(0.5, &Vector3::new(0.0, 0.0, -9.81), &com, &com, 10.0);
         assert_eq!(w, Wrench::new(0.0, 0.0, -4.905, 0.0, 0.0, 0.0));
-        let w2 = weight_wrench(0.5, &Vector3::new(0.0, 0.0, -9.81), &com, &Point3::origin(), 10.0);
+        let w2 = weight_wrench(
+            0.5,
+            &Vector3::new(0.0, 0.0, -9.81),
+            &com,
+            &Point3::origin(),
+            10.0,
+        );
         assert!((w2[3] - 10.0 * 0.1 * -4.905).abs() < 1e-12);
     }
 }

@@ -9,9 +9,9 @@
 //!
 //! | module | what | cost (4 contacts) |
 //! | --- | --- | --- |
-//! | [`ellipsoid`] | the paper's eqs. (9)–(10), margin `n − f` | ~0.1 µs, no allocation |
-//! | [`exact`] | second-order cone programs (clarabel): exact closure, weight scale, forces | ~0.1 ms |
-//! | [`ferrari_canny`] | ε of the L1 and L∞ wrench spaces, 6-D hulls (Qhull) | ~1–10 ms |
+//! | [`ellipsoid`] | the paper's eqs. (9)–(10), margin `n − f` | ~0.3 µs, no allocation |
+//! | [`exact`] | second-order cone programs (clarabel): exact closure, weight scale, forces | ~0.2 ms |
+//! | [`ferrari_canny`] | ε of the L1 and L∞ wrench spaces, 6-D hulls (Qhull) | ε_L1 ~3 ms, ε_L∞ seconds |
 //!
 //! Supporting modules: [`contact`] (contacts and contact frames `U_i`),
 //! [`grasp_matrix`] (eq. (6), `G` with torque scale `γ`), [`finger_force`]

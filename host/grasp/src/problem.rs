@@ -379,7 +379,11 @@ fn vec3(v: &Value, field: &str) -> Result<[f64; 3], ProblemError> {
 
 fn object<'a>(v: &'a Value, field: &str) -> Result<&'a Map<String, Value>, ProblemError> {
     v.as_object().ok_or_else(|| ProblemError::NotAnObject {
-        field: if field.is_empty() { "problem".into() } else { field.to_string() },
+        field: if field.is_empty() {
+            "problem".into()
+        } else {
+            field.to_string()
+        },
     })
 }
 
@@ -405,7 +409,10 @@ fn parse_finger(v: &Value, field: &str) -> Result<FingerSpec, ProblemError> {
         .enumerate()
         .map(|(i, row)| numbers(row, &format!("{jf}[{i}]")))
         .collect::<Result<_, _>>()?;
-    let effort_limits = numbers(get(obj, "effort_limits", field)?, &join(field, "effort_limits"))?;
+    let effort_limits = numbers(
+        get(obj, "effort_limits", field)?,
+        &join(field, "effort_limits"),
+    )?;
     let k = effort_limits.len();
     if r.iter().any(|row| row.len() != k) {
         return Err(ProblemError::InvalidValue {
@@ -427,12 +434,13 @@ impl Problem {
     /// Parses one problem from a JSON value, naming the first bad field.
     pub fn from_value(v: &Value) -> Result<Self, ProblemError> {
         let obj = object(v, "")?;
-        let contacts_v = get(obj, "contacts", "")?
-            .as_array()
-            .ok_or_else(|| ProblemError::InvalidType {
-                field: "contacts".into(),
-                expected: "an array of contacts",
-            })?;
+        let contacts_v =
+            get(obj, "contacts", "")?
+                .as_array()
+                .ok_or_else(|| ProblemError::InvalidType {
+                    field: "contacts".into(),
+                    expected: "an array of contacts",
+                })?;
         let mut contacts = Vec::with_capacity(contacts_v.len());
         for (i, c) in contacts_v.iter().enumerate() {
             let path = format!("contacts[{i}]");
@@ -520,7 +528,10 @@ impl Problem {
                 .map(|g| vec3(g, "gravity"))
                 .transpose()?
                 .unwrap_or(DEFAULT_GRAVITY),
-            characteristic_length: number(get(obj, "characteristic_length", "")?, "characteristic_length")?,
+            characteristic_length: number(
+                get(obj, "characteristic_length", "")?,
+                "characteristic_length",
+            )?,
             methods,
             alpha: opt_num("alpha")?.unwrap_or(DEFAULT_ALPHA),
             ellipsoid_centre,
@@ -640,7 +651,10 @@ impl Problem {
             EllipsoidCentre::Inscribed => EllipsoidModel::inscribed(self.alpha),
             EllipsoidCentre::Paper => EllipsoidModel::paper(self.alpha),
         };
-        self.ellipsoid_scales.iter().map(|&s| base.scaled(s)).collect()
+        self.ellipsoid_scales
+            .iter()
+            .map(|&s| base.scaled(s))
+            .collect()
     }
 }
 
@@ -676,12 +690,16 @@ fn finger_limit(finger: &FingerSpec, normal: &[f64; 3], path: &str) -> Result<f6
     }
     let j = Matrix3xX::from_fn(k, |r, c| finger.jacobian[r][c]);
     let n = Vector3::from(*normal);
-    max_finger_force(&j, &DVector::from_vec(finger.effort_limits.clone()), &n.normalize())
-        .map(|f| f.force)
-        .map_err(|e| ProblemError::InvalidValue {
-            field: path.to_string(),
-            message: e.to_string(),
-        })
+    max_finger_force(
+        &j,
+        &DVector::from_vec(finger.effort_limits.clone()),
+        &n.normalize(),
+    )
+    .map(|f| f.force)
+    .map_err(|e| ProblemError::InvalidValue {
+        field: path.to_string(),
+        message: e.to_string(),
+    })
 }
 
 // ---- results ----
@@ -803,11 +821,12 @@ pub fn solve_problem(problem: &Problem) -> Result<ProblemResult, ProblemError> {
                     }
                 } else {
                     let t0 = Instant::now();
-                    let t = multi_ellipsoid_test(&grasp, &models, &weight, MAX_ELLIPSOID_COMBINATIONS)
-                        .map_err(|e| ProblemError::MethodFailed {
-                            method: "ellipsoid",
-                            message: e.to_string(),
-                        })?;
+                    let t =
+                        multi_ellipsoid_test(&grasp, &models, &weight, MAX_ELLIPSOID_COMBINATIONS)
+                            .map_err(|e| ProblemError::MethodFailed {
+                                method: "ellipsoid",
+                                message: e.to_string(),
+                            })?;
                     let time_ns = elapsed_ns(t0);
                     EllipsoidResult {
                         force_closure: t.worst.force_closure(delta_f),
@@ -830,10 +849,11 @@ pub fn solve_problem(problem: &Problem) -> Result<ProblemResult, ProblemError> {
                     },
                 };
                 let t0 = Instant::now();
-                let t = exact_test(&grasp, cone, &weight).map_err(|e| ProblemError::MethodFailed {
-                    method: "exact",
-                    message: e.to_string(),
-                })?;
+                let t =
+                    exact_test(&grasp, cone, &weight).map_err(|e| ProblemError::MethodFailed {
+                        method: "exact",
+                        message: e.to_string(),
+                    })?;
                 let time_ns = elapsed_ns(t0);
                 out.exact = Some(ExactResult {
                     force_closure: t.closure.force_closure,
@@ -895,9 +915,13 @@ pub fn solve_value(v: &Value, index: usize) -> Value {
 pub fn solve_json(input: &str) -> String {
     let answer = match serde_json::from_str::<Value>(input) {
         Err(e) => ProblemError::Parse(e.to_string()).to_json(None),
-        Ok(Value::Array(problems)) => {
-            Value::Array(problems.iter().enumerate().map(|(i, p)| solve_value(p, i)).collect())
-        }
+        Ok(Value::Array(problems)) => Value::Array(
+            problems
+                .iter()
+                .enumerate()
+                .map(|(i, p)| solve_value(p, i))
+                .collect(),
+        ),
         Ok(one) => solve_value(&one, 0),
     };
     answer.to_string()

@@ -13,23 +13,47 @@ fn exact_agrees_with_ferrari_canny_and_the_inner_ellipsoid_never_lies() {
     println!("exact(8-pyramid) vs eps_L1 > 0: {}", s.exact_vs_l1);
     println!("exact(8-pyramid) vs eps_Linf > 0: {}", s.exact_vs_linf);
     println!("ellipsoid closure, delta_f = 0: {}", s.ellipsoid_closure);
-    println!("ellipsoid closure, delta_f = n-1: {}", s.ellipsoid_closure_inner);
+    println!(
+        "ellipsoid closure, delta_f = n-1: {}",
+        s.ellipsoid_closure_inner
+    );
     println!("ellipsoid weight, delta_f = 0: {}", s.ellipsoid_weight);
-    println!("ellipsoid weight, delta_f = n-1: {}", s.ellipsoid_weight_inner);
-    println!("zero-FP delta_f (closure): {}", common::Sweep::zero_fp_delta(&s.closure_margins, None));
-    println!("zero-FP delta_f (weight): {}", common::Sweep::zero_fp_delta(&s.weight_margins, None));
+    println!(
+        "ellipsoid weight, delta_f = n-1: {}",
+        s.ellipsoid_weight_inner
+    );
+    println!(
+        "zero-FP delta_f (closure): {}",
+        common::Sweep::zero_fp_delta(&s.closure_margins, None)
+    );
+    println!(
+        "zero-FP delta_f (weight): {}",
+        common::Sweep::zero_fp_delta(&s.weight_margins, None)
+    );
 
     // Same cone model, same answer (up to boundary cases of measure zero).
     assert!(s.exact_vs_l1.agreement() >= 0.999, "{}", s.exact_vs_l1);
     assert_eq!(s.exact_vs_linf.total(), 16);
     assert!(s.exact_vs_linf.agreement() >= 0.999, "{}", s.exact_vs_linf);
     // The set must exercise both answers.
-    assert!(s.exact_vs_l1.true_pos > 80 && s.exact_vs_l1.true_neg > 80, "{}", s.exact_vs_l1);
+    assert!(
+        s.exact_vs_l1.true_pos > 80 && s.exact_vs_l1.true_neg > 80,
+        "{}",
+        s.exact_vs_l1
+    );
     // The inscribed pyramid is inside the cone: it can only lose closure.
     assert_eq!(s.poly_vs_circular.false_pos, 0, "{}", s.poly_vs_circular);
     // With threshold 1 (δf = n − 1) eq. (10) is an inner approximation of the
     // Minkowski sum of ellipsoids that lie inside the bounded cones: a theorem,
     // so not one false positive.
-    assert_eq!(s.ellipsoid_closure_inner.false_pos, 0, "{}", s.ellipsoid_closure_inner);
-    assert_eq!(s.ellipsoid_weight_inner.false_pos, 0, "{}", s.ellipsoid_weight_inner);
+    assert_eq!(
+        s.ellipsoid_closure_inner.false_pos, 0,
+        "{}",
+        s.ellipsoid_closure_inner
+    );
+    assert_eq!(
+        s.ellipsoid_weight_inner.false_pos, 0,
+        "{}",
+        s.ellipsoid_weight_inner
+    );
 }

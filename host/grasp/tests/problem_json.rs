@@ -70,8 +70,23 @@ fn arrays_keep_order_and_bad_problems_get_error_objects() {
     let mut long_normal = pinch();
     long_normal["contacts"][0]["normal"] = json!([-2.0, 0.0, 0.0]);
     let mut missing = pinch();
-    missing.as_object_mut().unwrap().remove("characteristic_length");
-    let input = json!([pinch(), bad_normal, one_contact, mu, f_max, method, nan, three_finger(), long_normal, missing, 7]);
+    missing
+        .as_object_mut()
+        .unwrap()
+        .remove("characteristic_length");
+    let input = json!([
+        pinch(),
+        bad_normal,
+        one_contact,
+        mu,
+        f_max,
+        method,
+        nan,
+        three_finger(),
+        long_normal,
+        missing,
+        7
+    ]);
     let out = solve(&input);
     let out = out.as_array().unwrap();
     assert_eq!(out.len(), 11);
@@ -163,5 +178,8 @@ fn problem_round_trips_through_serde() {
     let again: Problem = serde_json::from_value(serde_json::to_value(&p).unwrap()).unwrap();
     assert_eq!(p, again);
     let err = serde_json::from_value::<Problem>(json!({"contacts": []})).unwrap_err();
-    assert!(err.to_string().contains("mu") || err.to_string().contains("contacts"), "{err}");
+    assert!(
+        err.to_string().contains("mu") || err.to_string().contains("contacts"),
+        "{err}"
+    );
 }

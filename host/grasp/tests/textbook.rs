@@ -29,7 +29,10 @@ fn antipodal_pinch_is_not_force_closure_but_holds_its_weight() {
     let g = pinch();
     let w = down(&g, 0.1);
     let e = ellipsoid_test(&g, &EllipsoidModel::default(), &w);
-    assert!(e.degenerate, "nothing resists torque about the contact line");
+    assert!(
+        e.degenerate,
+        "nothing resists torque about the contact line"
+    );
     assert!(!e.force_closure(0.0));
     for cone in CONES {
         let x = exact_test(&g, cone, &w).unwrap();
@@ -51,7 +54,10 @@ fn antipodal_pinch_is_not_force_closure_but_holds_its_weight() {
         assert!(x.resists_weight());
     }
     assert_eq!(epsilon_l1(&g, 8).unwrap(), 0.0);
-    assert_eq!(epsilon_linf(&g, &FerrariCannyOptions::default()).unwrap(), 0.0);
+    assert_eq!(
+        epsilon_linf(&g, &FerrariCannyOptions::default()).unwrap(),
+        0.0
+    );
     // The ellipsoid's flat wrench set still contains the (torque-free) weight.
     assert!(e.resists(0.0));
 }
@@ -65,7 +71,16 @@ fn three_fingers_at_120_degrees_are_force_closure() {
     // Symmetric: w0 = 0, so f(0) = 0 and the margin is n.
     assert!((e.closure_margin() - 3.0).abs() < 1e-9);
     assert!(e.force_closure(0.0) && e.resists(0.0));
-    let multi = multi_ellipsoid_test(&g, &[EllipsoidModel::default(), EllipsoidModel::default().scaled(0.5)], &w, 100).unwrap();
+    let multi = multi_ellipsoid_test(
+        &g,
+        &[
+            EllipsoidModel::default(),
+            EllipsoidModel::default().scaled(0.5),
+        ],
+        &w,
+        100,
+    )
+    .unwrap();
     assert_eq!(multi.combinations, 8);
     assert!(multi.worst.force_closure(0.0));
     for cone in CONES {
@@ -74,10 +89,18 @@ fn three_fingers_at_120_degrees_are_force_closure() {
         assert_eq!(x.closure.grasp_rank, 6);
         // Vertical friction capacity is at most 3 μ f_max.
         let s = x.weight.weight_scale;
-        assert!(s > 1.0 && s <= 3.0 * 0.5 * 10.0 / (0.1 * 9.81) * (1.0 + 1e-6), "{cone:?}: {s}");
+        assert!(
+            s > 1.0 && s <= 3.0 * 0.5 * 10.0 / (0.1 * 9.81) * (1.0 + 1e-6),
+            "{cone:?}: {s}"
+        );
         // The returned forces balance s × the weight and respect the cones.
         let mut total = Wrench::zeros();
-        for ((c, f), &f_max) in g.contacts().iter().zip(&x.weight.forces).zip(g.force_limits()) {
+        for ((c, f), &f_max) in g
+            .contacts()
+            .iter()
+            .zip(&x.weight.forces)
+            .zip(g.force_limits())
+        {
             total += contact_block(c, g.reference(), g.torque_scale()) * f;
             let fn_ = f.dot(c.normal());
             assert!(fn_ <= f_max * (1.0 + 1e-6));
@@ -97,7 +120,11 @@ fn circular_exact_weight_scale_is_three_mu_f_max() {
     let w = down(&g, 0.1);
     let x = exact_weight_scale(&g, ConeModel::Circular, &w).unwrap();
     let expected = 3.0 * 0.5 * 10.0 / 0.981;
-    assert!((x.weight_scale - expected).abs() < 1e-5 * expected, "{}", x.weight_scale);
+    assert!(
+        (x.weight_scale - expected).abs() < 1e-5 * expected,
+        "{}",
+        x.weight_scale
+    );
 }
 
 #[test]
@@ -110,26 +137,46 @@ fn parallel_normals_are_not_force_closure() {
     let g = Grasp::new(contacts, 0.8, 10.0, 0.04, Point3::origin()).unwrap();
     let w = down(&g, 0.2);
     let e = ellipsoid_test(&g, &EllipsoidModel::default(), &w);
-    assert!(!e.force_closure(0.0), "closure margin {}", e.closure_margin());
+    assert!(
+        !e.force_closure(0.0),
+        "closure margin {}",
+        e.closure_margin()
+    );
     for cone in CONES {
         let c = exact_force_closure(&g, cone).unwrap();
         assert!(!c.force_closure);
-        assert_eq!(c.grasp_rank, 6, "rank is fine, the cones are all on one side");
+        assert_eq!(
+            c.grasp_rank, 6,
+            "rank is fine, the cones are all on one side"
+        );
         assert!(c.squeeze_margin <= 1e-6);
     }
     assert_eq!(epsilon_l1(&g, 8).unwrap(), 0.0);
-    assert_eq!(epsilon_linf(&g, &FerrariCannyOptions::default()).unwrap(), 0.0);
+    assert_eq!(
+        epsilon_linf(&g, &FerrariCannyOptions::default()).unwrap(),
+        0.0
+    );
     // Resting on three supports, it does hold its weight.
-    assert!(exact_weight_scale(&g, ConeModel::Circular, &w).unwrap().weight_scale > 1.0);
+    assert!(
+        exact_weight_scale(&g, ConeModel::Circular, &w)
+            .unwrap()
+            .weight_scale
+            > 1.0
+    );
 }
 
 #[test]
 fn contacts_at_one_point_are_not_force_closure() {
     let p = Point3::new(0.0, 0.0, 0.03);
-    let contacts = [[0.0, 0.3, -1.0], [0.26, -0.15, -1.0], [-0.26, -0.15, -1.0], [0.0, 0.0, -1.0]]
-        .iter()
-        .map(|n| Contact::new(p, Vector3::from(*n).normalize()).unwrap())
-        .collect();
+    let contacts = [
+        [0.0, 0.3, -1.0],
+        [0.26, -0.15, -1.0],
+        [-0.26, -0.15, -1.0],
+        [0.0, 0.0, -1.0],
+    ]
+    .iter()
+    .map(|n| Contact::new(p, Vector3::from(*n).normalize()).unwrap())
+    .collect();
     let g = Grasp::new(contacts, 1.0, 10.0, 0.03, Point3::origin()).unwrap();
     let w = down(&g, 0.1);
     let e = ellipsoid_test(&g, &EllipsoidModel::default(), &w);
@@ -140,7 +187,10 @@ fn contacts_at_one_point_are_not_force_closure() {
         assert_eq!(c.grasp_rank, 3);
     }
     assert_eq!(epsilon_l1(&g, 8).unwrap(), 0.0);
-    assert_eq!(epsilon_linf(&g, &FerrariCannyOptions::default()).unwrap(), 0.0);
+    assert_eq!(
+        epsilon_linf(&g, &FerrariCannyOptions::default()).unwrap(),
+        0.0
+    );
 }
 
 #[test]
@@ -154,10 +204,56 @@ fn four_fingers_on_a_can_hold_its_weight() {
     let x = exact_test(&g, ConeModel::Circular, &w).unwrap();
     assert!(x.closure.force_closure && x.resists_weight());
     // f_max = 1 N cannot hold 3.43 N with μ = 0.5 on four fingers (at most 2 N).
-    let weak = Grasp::new(g.contacts().to_vec(), 0.5, 1.0, common::CAN_RADIUS, Point3::origin()).unwrap();
+    let weak = Grasp::new(
+        g.contacts().to_vec(),
+        0.5,
+        1.0,
+        common::CAN_RADIUS,
+        Point3::origin(),
+    )
+    .unwrap();
     let xw = exact_test(&weak, ConeModel::Circular, &w).unwrap();
     assert!(xw.closure.force_closure && !xw.resists_weight());
     assert!((xw.weight.weight_scale - 2.0 / 3.4335).abs() < 1e-5);
     let ew = ellipsoid_test(&weak, &EllipsoidModel::default(), &w);
     assert!(ew.force_closure(0.0) && !ew.resists(0.0));
+}
+
+#[test]
+fn linf_epsilon_of_a_box_grasp_is_at_least_l1() {
+    // Regression: two contacts on one face and one opposite. The L∞ sum of the
+    // first two contacts is flat (5-D); the last hull used to be rebuilt from
+    // its own vertices, which Qhull rejected, reporting ε_L∞ = 0.
+    let contacts = vec![
+        Contact::new(Point3::new(-0.0253, 0.02, 0.0222), -Vector3::y()).unwrap(),
+        Contact::new(Point3::new(-0.0033, -0.02, 0.0413), Vector3::y()).unwrap(),
+        Contact::new(Point3::new(0.0251, 0.02, 0.0433), -Vector3::y()).unwrap(),
+    ];
+    let g = Grasp::new(contacts, 0.5, 10.0, 0.04, Point3::origin()).unwrap();
+    let l1 = epsilon_l1(&g, 8).unwrap();
+    let linf = epsilon_linf(&g, &FerrariCannyOptions::default()).unwrap();
+    assert!(l1 > 0.1 && linf >= l1, "{l1} {linf}");
+    assert!(
+        exact_force_closure(&g, ConeModel::Polyhedral { sides: 8 })
+            .unwrap()
+            .force_closure
+    );
+}
+
+#[test]
+fn linf_refuses_sums_over_the_point_limit() {
+    let g = common::equator_grasp(3, 0.03, 0.5);
+    let small = FerrariCannyOptions {
+        sides: 8,
+        max_points: 100,
+    };
+    assert!(matches!(
+        epsilon_linf(&g, &small),
+        Err(
+            tsukami_grasp::ferrari_canny::FerrariCannyError::TooManyPoints {
+                points: 729,
+                limit: 100
+            }
+        )
+    ));
 }

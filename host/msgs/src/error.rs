@@ -122,7 +122,10 @@ impl std::error::Error for ErrorReply {}
 /// the JSON path of the offending field for wrong types, missing or unknown fields.
 pub fn parse_request<T: serde::de::DeserializeOwned>(payload: &[u8]) -> Result<T, ErrorReply> {
     let value: serde_json::Value = serde_json::from_slice(payload).map_err(|e| {
-        ErrorReply::new(ErrorCode::MalformedJson, format!("payload is not valid JSON: {e}"))
+        ErrorReply::new(
+            ErrorCode::MalformedJson,
+            format!("payload is not valid JSON: {e}"),
+        )
     })?;
     serde_path_to_error::deserialize(value).map_err(|e| {
         let path = e.path().to_string();
@@ -162,13 +165,22 @@ mod tests {
 
     #[test]
     fn unknown_field_is_refused() {
-        let err = parse_request::<Sample>(br#"{"mass": 1.0, "name": "x", "colour": 1}"#).unwrap_err();
-        assert!(err.error.message.contains("colour"), "{}", err.error.message);
+        let err =
+            parse_request::<Sample>(br#"{"mass": 1.0, "name": "x", "colour": 1}"#).unwrap_err();
+        assert!(
+            err.error.message.contains("colour"),
+            "{}",
+            err.error.message
+        );
     }
 
     #[test]
     fn error_codes_round_trip_their_wire_names() {
-        for code in [ErrorCode::MalformedJson, ErrorCode::PluginPanicked, ErrorCode::NotReady] {
+        for code in [
+            ErrorCode::MalformedJson,
+            ErrorCode::PluginPanicked,
+            ErrorCode::NotReady,
+        ] {
             assert_eq!(ErrorCode::from_wire(code.as_str()), code);
         }
         assert_eq!(ErrorCode::from_wire("no-such-code"), ErrorCode::Internal);

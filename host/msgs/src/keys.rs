@@ -130,19 +130,34 @@ mod tests {
     #[test]
     fn keys_follow_the_design_table() {
         let ks = KeySpace::default();
-        assert_eq!(ks.command(ROLE_GRASP_PLANNER, planner::PLAN), "tsukami/planner/plan");
+        assert_eq!(
+            ks.command(ROLE_GRASP_PLANNER, planner::PLAN),
+            "tsukami/planner/plan"
+        );
         assert_eq!(ks.progress(ROLE_GRASP_PLANNER), "tsukami/planner/progress");
-        assert_eq!(ks.command(ROLE_TRAJECTORY_PLANNER, "plan"), "tsukami/motion/plan");
+        assert_eq!(
+            ks.command(ROLE_TRAJECTORY_PLANNER, "plan"),
+            "tsukami/motion/plan"
+        );
         assert_eq!(ks.host_plugins(), "tsukami/host/plugins");
         assert_eq!(ks.vision_pose("can"), "tsukami/vision/pose/can");
-        assert_eq!(KeySpace::new("robot2/").role_wildcard("grasp-planner"), "robot2/planner/**");
+        assert_eq!(
+            KeySpace::new("robot2/").role_wildcard("grasp-planner"),
+            "robot2/planner/**"
+        );
     }
 
     #[test]
     fn command_of_strips_the_role_prefix() {
         let ks = KeySpace::new("ns");
-        assert_eq!(ks.command_of(ROLE_GRASP_PLANNER, "ns/planner/set_robot"), Some("set_robot"));
+        assert_eq!(
+            ks.command_of(ROLE_GRASP_PLANNER, "ns/planner/set_robot"),
+            Some("set_robot")
+        );
         assert_eq!(ks.command_of(ROLE_GRASP_PLANNER, "ns/motion/plan"), None);
-        assert_eq!(ks.command_of("test-slow", "ns/test-slow/echo"), Some("echo"));
+        assert_eq!(
+            ks.command_of("test-slow", "ns/test-slow/echo"),
+            Some("echo")
+        );
     }
 }

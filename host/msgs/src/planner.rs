@@ -2,7 +2,7 @@
 //!
 //! What: the request and reply payloads of the planner's queryables —
 //! [`SetRobot`], [`SetObject`], [`SetEnv`], [`RemoveEnv`], [`PlanOptions`] /
-//! [`PlanReply`], [`Stop`] — and the [`ProgressEvent`] it publishes while
+//! [`PlanReply`] — and the [`ProgressEvent`] it publishes while
 //! planning.
 //!
 //! Why: the same JSON travels in-process (through the plugin boundary) and over
@@ -34,37 +34,13 @@ use std::collections::BTreeMap;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-/// A rigid pose: position in metres and unit quaternion `[x, y, z, w]`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct Pose {
-    /// Position `[x, y, z]` in metres.
-    pub position: [f64; 3],
-    /// Orientation as a unit quaternion `[x, y, z, w]` (normalised by the receiver).
-    #[serde(default = "identity_quaternion")]
-    pub quaternion: [f64; 4],
-}
+pub use crate::common::Pose;
 
-fn identity_quaternion() -> [f64; 4] {
-    [0.0, 0.0, 0.0, 1.0]
-}
-
-impl Default for Pose {
-    fn default() -> Self {
-        Self {
-            position: [0.0; 3],
-            quaternion: identity_quaternion(),
-        }
-    }
-}
-
-impl Pose {
-    /// A pose at `position` with the identity orientation.
-    pub fn at(position: [f64; 3]) -> Self {
-        Self {
-            position,
-            quaternion: identity_quaternion(),
-        }
+/// A pose at `position` with the identity orientation.
+pub fn pose_at(position: [f64; 3]) -> Pose {
+    Pose {
+        position,
+        quaternion: Pose::IDENTITY.quaternion,
     }
 }
 
@@ -402,7 +378,8 @@ pub struct PlanOptions {
     /// Restrict the search to these grasp-type names (default: all).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grasp_types: Option<Vec<String>>,
-    /// Maximum number of grasp-type candidates tried, in score order (default 6).
+    /// Maximum number of nominal palm poses (grasp type × OCP face × rotation)
+    /// searched per whole-body stage, best first (default 6).
     #[serde(default = "default_max_candidates")]
     pub max_candidates: u32,
 }
@@ -569,7 +546,8 @@ pub struct PlanReply {
     pub samples: u32,
     /// Time per phase.
     pub timing_ms: PhaseTiming,
-    /// Grasp-type candidates in score order (eq. (3)) that were tried.
+    /// Grasp types of the nominal palm poses searched, in the order tried
+    /// (ranked by the palm criterion plus the weighted eq. (3) score).
     pub candidates_tried: Vec<String>,
 }
 
@@ -577,17 +555,8 @@ pub struct PlanReply {
 // stop / progress
 // ---------------------------------------------------------------------------
 
-/// `tsukami/planner/stop`: cancel the running plan, if any.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct Stop {}
-
-/// Reply to [`Stop`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-pub struct StopReply {
-    /// A plan was running and has been asked to stop.
-    pub stopped: bool,
-}
+// `tsukami/planner/stop` is answered by the host for every role (see
+// `crate::host::StopReply`): it must work while the plugin is busy planning.
 
 /// Phase a [`ProgressEvent`] reports on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
@@ -639,7 +608,7 @@ mod tests {
             },
             ocp_region: 0,
             face: BoxFace::NegX,
-            palm_pose: Pose::default(),
+            palm_pose: Pose::IDENTITY,
             joint_positions: BTreeMap::from([("r_elbow".to_string(), -1.0)]),
             joints_used: vec!["squat_z".into()],
             contacts: vec![ContactReply {
@@ -689,7 +658,6 @@ mod tests {
     fn requests_reject_unknown_fields() {
         assert!(serde_json::from_str::<SetRobot>(r#"{"robot":"x","urdf":"y"}"#).is_err());
         assert!(serde_json::from_str::<SetEnv>(r#"{"obstacle":[]}"#).is_err());
-        assert!(serde_json::from_str::<Stop>(r#"{"now":true}"#).is_err());
         let env: SetEnv = serde_json::from_str(
             r#"{"obstacles":[{"name":"table","shape":{"box":{"size":[1,1,0.7]}},
                 "pose":{"position":[0.6,0,0.35]}}]}"#,

@@ -34,6 +34,16 @@ pub fn all() -> Vec<NamedSchema> {
         named::<crate::controller::ControllerState>("controller_state"),
         named::<crate::vision::DetectRequest>("vision_detect_request"),
         named::<crate::vision::ObjectPose>("vision_object_pose"),
+        named::<crate::planner::SetRobot>("planner_set_robot_request"),
+        named::<crate::planner::RobotSummary>("planner_set_robot_reply"),
+        named::<crate::planner::SetObject>("planner_set_object_request"),
+        named::<crate::planner::ObjectSummary>("planner_set_object_reply"),
+        named::<crate::planner::SetEnv>("planner_set_env_request"),
+        named::<crate::planner::RemoveEnv>("planner_remove_env_request"),
+        named::<crate::planner::EnvSummary>("planner_env_reply"),
+        named::<crate::planner::PlanOptions>("planner_plan_request"),
+        named::<crate::planner::PlanReply>("planner_plan_reply"),
+        named::<crate::planner::ProgressEvent>("planner_progress"),
     ]
 }
 

@@ -1,7 +1,10 @@
 //! The plugin side of the boundary: adapts a [`Plugin`] to the FFI traits and catches
 //! its panics before they reach the `extern "C"` boundary (where they would abort).
 
-use crate::ffi::{FfiCallError, FfiHostBox, FfiPlugin, FfiPluginBox, FfiPluginInfo, FfiPlugin_TO, PluginModule, PluginModuleRef};
+use crate::ffi::{
+    FfiCallError, FfiHostBox, FfiPlugin, FfiPluginBox, FfiPluginInfo, FfiPlugin_TO, PluginModule,
+    PluginModuleRef,
+};
 use crate::safe::{into_ffi_result, CallContext, CallError, Host, Plugin, PluginInfo};
 use abi_stable::prefix_type::PrefixTypeTrait;
 use abi_stable::sabi_trait::TD_Opaque;
@@ -58,10 +61,18 @@ extern "C" fn info_of<P: Plugin>() -> FfiPluginInfo {
         .to_ffi()
 }
 
-extern "C" fn new_of<P: Plugin>(host: FfiHostBox, config: RStr<'_>) -> RResult<FfiPluginBox, RString> {
+extern "C" fn new_of<P: Plugin>(
+    host: FfiHostBox,
+    config: RStr<'_>,
+) -> RResult<FfiPluginBox, RString> {
     let host = Host::from_ffi(host);
     let created = catch_unwind(AssertUnwindSafe(|| P::new(host.clone(), config.as_str())))
-        .unwrap_or_else(|panic| Err(format!("panicked in new(): {}", panic_message(panic.as_ref()))));
+        .unwrap_or_else(|panic| {
+            Err(format!(
+                "panicked in new(): {}",
+                panic_message(panic.as_ref())
+            ))
+        });
     match created {
         Ok(plugin) => RResult::ROk(FfiPlugin_TO::from_value(
             PluginAdapter { plugin, host },

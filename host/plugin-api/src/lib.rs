@@ -54,9 +54,9 @@
 //! A running call is cancelled by the host setting the call's cancel flag, which the
 //! plugin polls through [`CallContext::is_cancelled`].
 
+mod export;
 pub mod ffi;
 pub mod loader;
-mod export;
 mod safe;
 
 pub use safe::{CallContext, CallError, Host, LogLevel, Plugin, PluginInfo, Subscription};

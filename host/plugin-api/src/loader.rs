@@ -96,7 +96,11 @@ pub fn plugin_stem(path: &Path) -> String {
 /// The platform's file name for a library called `name`: `libname.so`,
 /// `libname.dylib` or `name.dll`.
 pub fn library_file_name(name: &str) -> String {
-    format!("{}{name}{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX)
+    format!(
+        "{}{name}{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    )
 }
 
 /// A loaded, checked plugin library, not yet created.
@@ -110,28 +114,41 @@ impl LoadedLibrary {
     /// Loads `path` and checks its interface version and layouts.
     pub fn load(path: &Path) -> Result<LoadedLibrary, LoadError> {
         if !path.is_file() {
-            return Err(LoadError::NotFound { path: path.to_owned() });
+            return Err(LoadError::NotFound {
+                path: path.to_owned(),
+            });
         }
         let header = lib_header_from_path(path).map_err(|e| LoadError::NotAPlugin {
             path: path.to_owned(),
             detail: e.to_string(),
         })?;
-        let module = header.init_root_module::<PluginModuleRef>().map_err(|e| match e {
-            LibraryError::IncompatibleVersionNumber { expected_version, actual_version, .. } => {
-                LoadError::IncompatibleVersion {
+        let module = header
+            .init_root_module::<PluginModuleRef>()
+            .map_err(|e| match e {
+                LibraryError::IncompatibleVersionNumber {
+                    expected_version,
+                    actual_version,
+                    ..
+                } => LoadError::IncompatibleVersion {
                     path: path.to_owned(),
                     plugin_interface: actual_version.to_string(),
                     host_interface: expected_version.to_string(),
-                }
-            }
-            LibraryError::AbiInstability(detail) => LoadError::IncompatibleLayout {
-                path: path.to_owned(),
-                detail: detail.to_string(),
-            },
-            other => LoadError::NotAPlugin { path: path.to_owned(), detail: other.to_string() },
-        })?;
+                },
+                LibraryError::AbiInstability(detail) => LoadError::IncompatibleLayout {
+                    path: path.to_owned(),
+                    detail: detail.to_string(),
+                },
+                other => LoadError::NotAPlugin {
+                    path: path.to_owned(),
+                    detail: other.to_string(),
+                },
+            })?;
         let info = PluginInfo::from_ffi(&(module.info())());
-        Ok(LoadedLibrary { path: path.to_owned(), module, info })
+        Ok(LoadedLibrary {
+            path: path.to_owned(),
+            module,
+            info,
+        })
     }
 
     /// The file it came from.
@@ -163,7 +180,12 @@ pub struct PluginInstance {
 
 impl PluginInstance {
     /// Runs one command; `cancel` may be set from another thread to stop it.
-    pub fn call(&mut self, command: &str, payload: &[u8], cancel: &AtomicBool) -> Result<Vec<u8>, CallError> {
+    pub fn call(
+        &mut self,
+        command: &str,
+        payload: &[u8],
+        cancel: &AtomicBool,
+    ) -> Result<Vec<u8>, CallError> {
         self.inner
             .call(RStr::from(command), RSlice::from(payload), cancel)
             .into_result()

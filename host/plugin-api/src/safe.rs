@@ -34,7 +34,11 @@ impl PluginInfo {
         FfiPluginInfo {
             name: self.name.as_str().into(),
             version: self.version.as_str().into(),
-            roles: self.roles.iter().map(|r| RString::from(r.as_str())).collect(),
+            roles: self
+                .roles
+                .iter()
+                .map(|r| RString::from(r.as_str()))
+                .collect(),
             description: self.description.as_str().into(),
         }
     }
@@ -170,7 +174,12 @@ impl Host {
 
     /// Queries `<ns>/<key>` and waits at most `timeout` for the reply bytes; an
     /// error reply from the other side comes back as its [`CallError`].
-    pub fn request(&self, key: &str, payload: &[u8], timeout: Duration) -> Result<Vec<u8>, CallError> {
+    pub fn request(
+        &self,
+        key: &str,
+        payload: &[u8],
+        timeout: Duration,
+    ) -> Result<Vec<u8>, CallError> {
         let timeout_ms = u64::try_from(timeout.as_millis()).unwrap_or(u64::MAX);
         self.inner
             .request(RStr::from(key), RSlice::from(payload), timeout_ms)
@@ -254,10 +263,17 @@ pub trait Plugin: Send + Sized + 'static {
     fn new(host: Host, config: &str) -> Result<Self, String>;
 
     /// Runs one command. `payload` is the request's JSON bytes; the reply is JSON bytes.
-    fn call(&mut self, command: &str, payload: &[u8], ctx: &CallContext<'_>) -> Result<Vec<u8>, CallError>;
+    fn call(
+        &mut self,
+        command: &str,
+        payload: &[u8],
+        ctx: &CallContext<'_>,
+    ) -> Result<Vec<u8>, CallError>;
 }
 
-pub(crate) fn into_ffi_result(result: Result<Vec<u8>, CallError>) -> RResult<RVec<u8>, FfiCallError> {
+pub(crate) fn into_ffi_result(
+    result: Result<Vec<u8>, CallError>,
+) -> RResult<RVec<u8>, FfiCallError> {
     match result {
         Ok(bytes) => RResult::ROk(RVec::from(bytes)),
         Err(err) => RResult::RErr(err.to_ffi()),

@@ -29,7 +29,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         mass: m,
         friction: None,
         center_of_mass: None,
-        pose: Pose::at([x, y, top + h / 2.0]),
+        pose: pose_at([x, y, top + h / 2.0]),
     })?;
     println!("{}", serde_json::to_string(&s.regions)?);
     p.set_env(&SetEnv {
@@ -38,7 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             shape: ObstacleShape::Box {
                 size: [0.5, 0.8, 0.04],
             },
-            pose: Pose::at([x + 0.1, y, top - 0.02]),
+            pose: pose_at([x + 0.1, y, top - 0.02]),
         }],
         replace: true,
     })?;

@@ -1,8 +1,8 @@
 //! Plans one scene of `models/scenes/` and prints the reply as JSON.
 //! Usage: `plan_scene models/scenes/can_breast.toml [SEED]`.
 use std::sync::atomic::AtomicBool;
-use tsukami_grasp_planner::{planner::Planner, scene::scene_requests};
 use tsukami_msgs::planner::PlanOptions;
+use {tsukami_grasp_planner::planner::Planner, tsukami_scenes::scene_requests};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -94,6 +94,8 @@ fn close_one(
     }
     let mut prox = first;
     let mut angle = prev;
+    // At most one turn, even for a joint without an upper limit.
+    let upper = upper.min(prev + std::f64::consts::TAU);
     while prox.distance >= threshold {
         if angle >= upper {
             return None; // closed fully without touching

@@ -355,9 +355,22 @@ impl GraspTypeConfig {
                 robot
                     .link_id(&c.link)
                     .map_err(|_| missing(&g.name, "contacts.link", "link", &c.link))?;
-                robot
+                let j = robot
                     .joint_id(&c.joint)
                     .map_err(|_| missing(&g.name, "contacts.joint", "joint", &c.joint))?;
+                let link = robot
+                    .link_id(&c.link)
+                    .map_err(|_| missing(&g.name, "contacts.link", "link", &c.link))?;
+                if robot.joints[j].mimic.is_some() || !robot.chain(link).contains(&j) {
+                    return Err(GraspTypeError::Invalid {
+                        grasp_type: g.name.clone(),
+                        field: "contacts.joint".into(),
+                        message: format!(
+                            "joint `{}` must be an independent joint between the palm and link `{}`",
+                            c.joint, c.link
+                        ),
+                    });
+                }
                 for p in &c.perturb {
                     robot
                         .joint_id(p)

@@ -11,10 +11,26 @@
 //! reference postures come from [`grasp_type`] (a TOML file, see
 //! `docs/grasp-types.md`), resolved against the robot in [`hand`]; objects are
 //! checked and placed in [`object`]; [`scene`] turns a scene file of `models/`
-//! into planner requests.
+//! into planner requests. [`plugin`] is the FFI adapter (the `grasp-planner`
+//! role), exported with `tsukami-plugin-api`'s `export_plugin!`.
 //!
 //! The algorithm does no I/O beyond loading model files through
 //! `tsukami-body`; the plugin adapter only (de)serialises messages.
+//!
+//! ```no_run
+//! use std::sync::atomic::AtomicBool;
+//! use tsukami_grasp_planner::planner::Planner;
+//! use tsukami_scenes::scene_requests;
+//! let req = scene_requests("models/scenes/can_breast.toml".as_ref()).unwrap();
+//! let mut planner = Planner::new("models");
+//! planner.set_robot(&req.robot).unwrap();
+//! planner.set_object(&req.object).unwrap();
+//! planner.set_env(&req.env).unwrap();
+//! let grasp = planner
+//!     .plan(&Default::default(), &AtomicBool::new(false), &mut |_| {})
+//!     .unwrap();
+//! assert_eq!(grasp.grasp_type.name, "fingertip4_mid");
+//! ```
 
 pub mod finger_closing;
 pub mod grasp_type;
@@ -23,7 +39,7 @@ pub mod object;
 pub mod ocp;
 pub mod palm_pose;
 pub mod planner;
-pub mod scene;
+pub mod plugin;
 pub mod search;
 pub mod selection;
 pub mod whole_body;

@@ -356,7 +356,7 @@ fn segment_profile(radii: &[f64], params: &OcpParams) -> Vec<std::ops::Range<usi
     let n = radii.len();
     let rmax = radii.iter().cloned().fold(0.0, f64::max);
     if n == 0 || rmax <= 0.0 {
-        return vec![0..n];
+        return std::iter::once(0..n).collect();
     }
     // 1. Cut at jumps and where a run's radius range grows too wide.
     let mut runs: Vec<std::ops::Range<usize>> = Vec::new();
@@ -439,7 +439,7 @@ fn segment_profile(radii: &[f64], params: &OcpParams) -> Vec<std::ops::Range<usi
 /// The OCPs of an object surface given in the world frame, with free faces.
 ///
 /// `vertices` and `triangles` must describe a valid surface (see
-/// [`crate::mesh_check`]); degenerate triangles are ignored. Regions are split
+/// [`crate::object::check_mesh`]); degenerate triangles are ignored. Regions are split
 /// along the box's longest axis; the support is the horizontal plane under the
 /// object's lowest point.
 pub fn object_ocps(
@@ -668,7 +668,7 @@ mod tests {
     #[test]
     fn lying_box_gets_its_own_axes() {
         // A 0.2 × 0.1 × 0.05 box rotated 30° about z.
-        let rot = Rotation3::from_axis_angle(&Vector3::z_axis(), 0.5236);
+        let rot = Rotation3::from_axis_angle(&Vector3::z_axis(), std::f64::consts::FRAC_PI_6);
         let half = Vector3::new(0.1, 0.05, 0.025);
         let v: Vec<Point3<f64>> = (0..8)
             .map(|i| {

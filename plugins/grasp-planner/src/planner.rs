@@ -27,7 +27,7 @@
 //!     name: None,
 //!     shape: ObjectShape::Model { name: "can_350ml".into() },
 //!     mass: 0.15, friction: None, center_of_mass: None,
-//!     pose: Pose::at([0.45, -0.25, 1.0]),
+//!     pose: pose_at([0.45, -0.25, 1.0]),
 //! })?;
 //! let reply = p.plan(&PlanOptions::default(), &AtomicBool::new(false), &mut |_| {})?;
 //! println!("{} on face {}", reply.grasp_type.name, reply.face.as_str());
@@ -76,9 +76,12 @@ pub enum PlanError {
     /// The robot or its grasp types could not be loaded.
     #[error("set_robot: {0}")]
     Robot(String),
-    /// The object was refused.
+    /// The object's model or mesh could not be loaded or is unusable (open, degenerate, huge).
     #[error("set_object: {0}")]
     Object(String),
+    /// A value of the object request is out of range (mass, pose, scale).
+    #[error("set_object: {0}")]
+    ObjectValue(String),
     /// A model name that is not under `models/`.
     #[error("unknown {kind} `{name}`: not found at {path}")]
     UnknownModel {
@@ -137,6 +140,7 @@ impl PlanError {
             PlanError::NoObject => "no_object",
             PlanError::Robot(_) => "bad_robot",
             PlanError::Object(_) => "bad_object",
+            PlanError::ObjectValue(_) => "bad_object_value",
             PlanError::UnknownModel { .. } => "unknown_model",
             PlanError::Env { .. } => "bad_env",
             PlanError::Options { .. } => "bad_options",
@@ -328,7 +332,13 @@ impl Planner {
 
     /// `set_object`: loads and checks the mesh, computes OCPs (state kept on error).
     pub fn set_object(&mut self, req: &SetObject) -> Result<ObjectSummary, PlanError> {
-        let pose = pose_to_iso(&req.pose, "pose").map_err(PlanError::Object)?;
+        let pose = pose_to_iso(&req.pose, "pose").map_err(PlanError::ObjectValue)?;
+        if !(req.mass.is_finite() && req.mass > 0.0) {
+            return Err(PlanError::ObjectValue(format!(
+                "field `mass`: {} kg must be finite and > 0",
+                req.mass
+            )));
+        }
         let (name, mesh, default_mu) = match &req.shape {
             ObjectShape::Model { name } => {
                 let path = self
@@ -349,7 +359,7 @@ impl Planner {
             ObjectShape::Mesh { path, scale } => {
                 let scale = scale.unwrap_or(1.0);
                 if !(scale.is_finite() && scale > 0.0) {
-                    return Err(PlanError::Object(format!(
+                    return Err(PlanError::ObjectValue(format!(
                         "shape.mesh.scale: {scale} must be > 0"
                     )));
                 }
@@ -665,7 +675,9 @@ impl Planner {
                 );
                 match outcome {
                     Outcome::Found(found) => {
-                        timing.search += ms(t2.elapsed());
+                        // The exact verification runs inside the search; report it apart.
+                        timing.search += ms(t2.elapsed()) - found.exact_ms;
+                        timing.verification = found.exact_ms;
                         let t3 = Instant::now();
                         progress(&event(
                             PlanPhase::Verification,
@@ -692,7 +704,7 @@ impl Planner {
                                 f_max: c.f_max,
                             })
                             .collect();
-                        timing.verification = ms(t3.elapsed());
+                        timing.verification += ms(t3.elapsed());
                         timing.total = ms(start.elapsed());
                         progress(&event(
                             PlanPhase::Done,

@@ -108,6 +108,8 @@ pub struct Found {
     pub margin: f64,
     /// Exact test: the weight is resisted.
     pub exact_resists_weight: bool,
+    /// Time spent in exact tests (ms).
+    pub exact_ms: f64,
 }
 
 /// How a search ended.
@@ -201,6 +203,7 @@ pub fn search(
     let object = &ctx.object.collision;
     let mut fk = FkState::new(robot);
     let mut q = q_nominal.to_vec();
+    let mut exact_ms = 0.0;
     for s in 0..p.max_samples {
         if ctx.cancel.load(Ordering::Relaxed) {
             return Outcome::Cancelled;
@@ -209,7 +212,7 @@ pub fn search(
             return Outcome::OutOfTime;
         }
         counters.samples += 1;
-        if counters.samples % 16 == 0 {
+        if counters.samples.is_multiple_of(16) {
             progress(counters);
         }
         // Δp_p: the OCP's offset w.r.t. the GRC moves the palm by −Δp_p.
@@ -306,7 +309,9 @@ pub fn search(
             continue;
         }
         // Confirm with the exact friction cones before answering.
+        let t_exact = Instant::now();
         let exact = exact_resists(ctx.object, &grasp);
+        exact_ms += t_exact.elapsed().as_secs_f64() * 1e3;
         if !exact {
             counters.rejections[4] += 1;
             continue;
@@ -318,6 +323,7 @@ pub fn search(
             contacts,
             margin,
             exact_resists_weight: exact,
+            exact_ms,
         }));
     }
     Outcome::Exhausted

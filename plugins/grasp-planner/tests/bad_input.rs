@@ -7,11 +7,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use nalgebra::Vector3;
 use tsukami_body::mesh::TriangleMesh;
 use tsukami_grasp_planner::planner::{PlanError, Planner};
-use tsukami_grasp_planner::scene::scene_requests;
 use tsukami_msgs::planner::{
-    ObjectShape, Obstacle, ObstacleShape, PlanOptions, PlanPhase, Pose, RemoveEnv, SetEnv,
+    pose_at, ObjectShape, Obstacle, ObstacleShape, PlanOptions, PlanPhase, Pose, RemoveEnv, SetEnv,
     SetObject, SetRobot,
 };
+use tsukami_scenes::scene_requests;
 
 fn models() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
@@ -41,7 +41,7 @@ fn mesh_object(path: &Path, mass: f64) -> SetObject {
         },
         mass,
         friction: None,
-        pose: Pose::at([0.5, -0.25, 1.1]),
+        pose: pose_at([0.5, -0.25, 1.1]),
         center_of_mass: None,
     }
 }
@@ -164,7 +164,7 @@ fn unseen_mesh_is_planned() {
     let path = tmp("unseen.obj");
     mesh.write_obj(&path).unwrap();
     let mut req = mesh_object(&path, 0.12);
-    req.pose = Pose::at([0.52, -0.25, 1.10]);
+    req.pose = pose_at([0.52, -0.25, 1.10]);
     let s = p.set_object(&req).unwrap();
     assert!(!s.regions.is_empty());
     let r = plan(&mut p).unwrap();
@@ -189,7 +189,7 @@ fn bad_env_and_options_are_refused() {
                 shape: ObstacleShape::Box {
                     size: [1.0, -1.0, 1.0],
                 },
-                pose: Pose::default(),
+                pose: Pose::IDENTITY,
             }],
             replace: true,
         })
@@ -252,7 +252,7 @@ fn far_object_is_unreachable_even_with_squat() {
         .write_stl(&path)
         .unwrap();
     let mut req = mesh_object(&path, 0.15);
-    req.pose = Pose::at([2.0, -0.25, 1.0]);
+    req.pose = pose_at([2.0, -0.25, 1.0]);
     p.set_object(&req).unwrap();
     let e = plan(&mut p).unwrap_err();
     assert_eq!(e.code(), "unreachable");
@@ -287,5 +287,46 @@ fn cancel_stops_the_plan_and_progress_is_reported() {
     assert_eq!(events.first(), Some(&PlanPhase::Selection));
     assert!(events.contains(&PlanPhase::Search));
     // The state survives: plan again.
+    plan(&mut p).unwrap();
+}
+
+#[test]
+fn bad_robots_are_refused_and_the_state_is_kept() {
+    let mut p = ready();
+    let e = p
+        .set_robot(&SetRobot {
+            robot: "no_such_robot".into(),
+            grasp_types: None,
+        })
+        .unwrap_err();
+    assert_eq!(e.code(), "unknown_model");
+    // A grasp-type file with a misspelt key names it.
+    let cfg = models().join("robots/tsukami_humanoid/grasp_types.toml");
+    let text = std::fs::read_to_string(&cfg)
+        .unwrap()
+        .replacen("closing_step", "closing_stepp", 1);
+    let bad = tmp("grasp_types_typo.toml");
+    std::fs::write(&bad, text).unwrap();
+    let e = p
+        .set_robot(&SetRobot {
+            robot: "tsukami_humanoid".into(),
+            grasp_types: Some(bad.display().to_string()),
+        })
+        .unwrap_err();
+    assert_eq!(e.code(), "bad_robot");
+    assert!(e.to_string().contains("closing_stepp"), "{e}");
+    // A joint name that is not in the robot.
+    let text =
+        std::fs::read_to_string(&cfg)
+            .unwrap()
+            .replacen("\"r_index_j3\"", "\"r_index_j9\"", 1);
+    std::fs::write(&bad, text).unwrap();
+    let e = p
+        .set_robot(&SetRobot {
+            robot: "tsukami_humanoid".into(),
+            grasp_types: Some(bad.display().to_string()),
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("r_index_j9"), "{e}");
     plan(&mut p).unwrap();
 }

@@ -21,10 +21,13 @@ pub struct FcArgs {
 pub fn run(args: &FcArgs) -> Result<()> {
     let text = if args.input.as_os_str() == "-" {
         let mut text = String::new();
-        std::io::stdin().read_to_string(&mut text).context("reading standard input")?;
+        std::io::stdin()
+            .read_to_string(&mut text)
+            .context("reading standard input")?;
         text
     } else {
-        std::fs::read_to_string(&args.input).with_context(|| format!("reading {}", args.input.display()))?
+        std::fs::read_to_string(&args.input)
+            .with_context(|| format!("reading {}", args.input.display()))?
     };
     println!("{}", tsukami_grasp::problem::solve_json(&text));
     Ok(())

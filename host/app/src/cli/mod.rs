@@ -68,10 +68,14 @@ struct Payload {
 impl Payload {
     fn bytes(&self) -> Result<Vec<u8>> {
         match (&self.json, &self.file) {
-            (_, Some(file)) => std::fs::read(file).with_context(|| format!("reading {}", file.display())),
+            (_, Some(file)) => {
+                std::fs::read(file).with_context(|| format!("reading {}", file.display()))
+            }
             (Some(text), None) if text == "-" => {
                 let mut buf = Vec::new();
-                std::io::stdin().read_to_end(&mut buf).context("reading standard input")?;
+                std::io::stdin()
+                    .read_to_end(&mut buf)
+                    .context("reading standard input")?;
                 Ok(buf)
             }
             (Some(text), None) => Ok(text.clone().into_bytes()),
@@ -127,8 +131,9 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     tracing_subscriber::fmt()
         .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env()
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn,tsukami=info")),
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| {
+                tracing_subscriber::EnvFilter::new("warn,tsukami=info,zenoh::net::routing=error")
+            }),
         )
         .with_writer(std::io::stderr)
         .init();
@@ -185,7 +190,12 @@ fn serve(config: Option<&std::path::Path>, listen: &[String], bus: &BusArgs) -> 
         config.bus.listen
     );
     for plugin in &host.plugins().plugins {
-        eprintln!("  {:<20} {} {}", plugin.roles.join(","), plugin.name, plugin.version);
+        eprintln!(
+            "  {:<20} {} {}",
+            plugin.roles.join(","),
+            plugin.name,
+            plugin.version
+        );
     }
     // Serve until the process is interrupted: the workers and zenoh run on their own
     // threads; this one only waits.
@@ -224,8 +234,13 @@ fn write_schema(out: &std::path::Path) -> Result<ExitCode> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     for schema in tsukami_msgs::schema::all() {
         let path = out.join(format!("{}.schema.json", schema.name));
-        std::fs::write(&path, schema.json).with_context(|| format!("writing {}", path.display()))?;
+        std::fs::write(&path, schema.json)
+            .with_context(|| format!("writing {}", path.display()))?;
     }
-    eprintln!("tsukami: wrote {} schemas to {}", tsukami_msgs::schema::all().len(), out.display());
+    eprintln!(
+        "tsukami: wrote {} schemas to {}",
+        tsukami_msgs::schema::all().len(),
+        out.display()
+    );
     Ok(ExitCode::SUCCESS)
 }

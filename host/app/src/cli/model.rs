@@ -53,7 +53,8 @@ pub enum ModelCommand {
 }
 
 fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
 }
 
@@ -69,7 +70,11 @@ pub fn run(command: &ModelCommand) -> Result<()> {
             let model = tsukami_body::urdf::load_urdf(file)?;
             print(&report::inspect(&model))
         }
-        ModelCommand::Fk { file, joints, batch } => {
+        ModelCommand::Fk {
+            file,
+            joints,
+            batch,
+        } => {
             let model = tsukami_body::urdf::load_urdf(file)?;
             match batch {
                 Some(path) => {
@@ -81,11 +86,21 @@ pub fn run(command: &ModelCommand) -> Result<()> {
                         .iter()
                         .map(|j| report::parse_joint_assignment(j))
                         .collect::<Result<Vec<_>, _>>()?;
-                    print(&report::fk(&model, assignments.iter().map(|(n, v)| (n.as_str(), *v)))?)
+                    print(&report::fk(
+                        &model,
+                        assignments.iter().map(|(n, v)| (n.as_str(), *v)),
+                    )?)
                 }
             }
         }
-        ModelCommand::Ik { file, link, target, joints, seed, batch } => {
+        ModelCommand::Ik {
+            file,
+            link,
+            target,
+            joints,
+            seed,
+            batch,
+        } => {
             let model = tsukami_body::urdf::load_urdf(file)?;
             match batch {
                 Some(path) => {
@@ -98,7 +113,9 @@ pub fn run(command: &ModelCommand) -> Result<()> {
                     print(&report::ik_batch(&model, &requests)?)
                 }
                 None => {
-                    let target = target.as_deref().context("--target x,y,z[,qx,qy,qz,qw] is required without --batch")?;
+                    let target = target
+                        .as_deref()
+                        .context("--target x,y,z[,qx,qy,qz,qw] is required without --batch")?;
                     let request = IkRequest {
                         link: link.clone(),
                         target: report::parse_target(target)?,

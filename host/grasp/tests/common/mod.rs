@@ -82,7 +82,11 @@ pub fn surface_contact(shape: Shape, rng: &mut ChaCha8Rng) -> Contact {
             let sign = if rng.random::<bool>() { 1.0 } else { -1.0 };
             let mut p = Vector3::zeros();
             for k in 0..3 {
-                p[k] = if k == axis { sign * e[k] } else { (rng.random::<f64>() * 2.0 - 1.0) * e[k] };
+                p[k] = if k == axis {
+                    sign * e[k]
+                } else {
+                    (rng.random::<f64>() * 2.0 - 1.0) * e[k]
+                };
             }
             let mut n = Vector3::zeros();
             n[axis] = -sign;
@@ -96,12 +100,23 @@ pub fn surface_contact(shape: Shape, rng: &mut ChaCha8Rng) -> Contact {
 pub fn random_grasp(shape: Shape, n: usize, rng: &mut ChaCha8Rng) -> Grasp {
     let contacts: Vec<Contact> = (0..n).map(|_| surface_contact(shape, rng)).collect();
     let mu = 0.2 + 0.8 * rng.random::<f64>();
-    Grasp::new(contacts, mu, 10.0, shape.characteristic_length(), Point3::origin()).expect("valid grasp")
+    Grasp::new(
+        contacts,
+        mu,
+        10.0,
+        shape.characteristic_length(),
+        Point3::origin(),
+    )
+    .expect("valid grasp")
 }
 
 /// The weight wrench of `shape` under standard gravity.
 pub fn weight(grasp: &Grasp, shape: Shape) -> tsukami_grasp::grasp_matrix::Wrench {
-    grasp.weight_wrench(shape.mass(), &Vector3::new(0.0, 0.0, -9.81), &Point3::origin())
+    grasp.weight_wrench(
+        shape.mass(),
+        &Vector3::new(0.0, 0.0, -9.81),
+        &Point3::origin(),
+    )
 }
 
 /// `n` fingers evenly spaced on the equator of a sphere of radius `r`.
@@ -200,7 +215,11 @@ impl Sweep {
     }
 
     /// Reference positives rejected at threshold δf, and the number of positives.
-    pub fn false_negatives_at(margins: &[(usize, f64, bool)], delta: f64, n: Option<usize>) -> (usize, usize) {
+    pub fn false_negatives_at(
+        margins: &[(usize, f64, bool)],
+        delta: f64,
+        n: Option<usize>,
+    ) -> (usize, usize) {
         let pos: Vec<f64> = margins
             .iter()
             .filter(|(k, _, truth)| *truth && n.is_none_or(|n| n == *k))
@@ -214,7 +233,13 @@ impl Sweep {
 /// `contacts`), seeded, and compares the methods. ε_L∞ (≈0.5 s a grasp of
 /// three contacts) is computed for the first `linf_per_shape` grasps of three
 /// contacts of each shape.
-pub fn sweep(cases: usize, seed: u64, contacts: &[usize], sides: usize, linf_per_shape: usize) -> Sweep {
+pub fn sweep(
+    cases: usize,
+    seed: u64,
+    contacts: &[usize],
+    sides: usize,
+    linf_per_shape: usize,
+) -> Sweep {
     use rand::SeedableRng;
     use tsukami_grasp::ellipsoid::{ellipsoid_test, EllipsoidModel};
     use tsukami_grasp::exact::{exact_force_closure, exact_weight_scale, ConeModel};
@@ -242,16 +267,23 @@ pub fn sweep(cases: usize, seed: u64, contacts: &[usize], sides: usize, linf_per
                 let linf = epsilon_linf(&g, &options).expect("hull");
                 s.exact_vs_linf.add(linf > 0.0, poly.force_closure);
             }
-            s.poly_vs_circular.add(poly.force_closure, circ.force_closure);
-            let resists = exact_weight_scale(&g, ConeModel::Circular, &w).expect("solver").weight_scale >= 1.0;
+            s.poly_vs_circular
+                .add(poly.force_closure, circ.force_closure);
+            let resists = exact_weight_scale(&g, ConeModel::Circular, &w)
+                .expect("solver")
+                .weight_scale
+                >= 1.0;
             let e = ellipsoid_test(&g, &model, &w);
             let inner = n as f64 - 1.0;
-            s.ellipsoid_closure.add(e.force_closure(0.0), circ.force_closure);
-            s.ellipsoid_closure_inner.add(e.force_closure(inner), circ.force_closure);
+            s.ellipsoid_closure
+                .add(e.force_closure(0.0), circ.force_closure);
+            s.ellipsoid_closure_inner
+                .add(e.force_closure(inner), circ.force_closure);
             s.ellipsoid_weight.add(e.resists(0.0), resists);
             s.ellipsoid_weight_inner.add(e.resists(inner), resists);
             if !e.degenerate {
-                s.closure_margins.push((n, e.closure_margin(), circ.force_closure));
+                s.closure_margins
+                    .push((n, e.closure_margin(), circ.force_closure));
             }
             s.weight_margins.push((n, e.margin(), resists));
         }

@@ -8,12 +8,8 @@
 #![allow(non_local_definitions)]
 
 use abi_stable::{
-    declare_root_module_statics, export_root_module,
-    library::RootModule,
-    prefix_type::PrefixTypeTrait,
-    sabi_types::VersionStrings,
-    std_types::RString,
-    StableAbi,
+    declare_root_module_statics, export_root_module, library::RootModule,
+    prefix_type::PrefixTypeTrait, sabi_types::VersionStrings, std_types::RString, StableAbi,
 };
 
 /// The 0.1.0 root module.

@@ -12,14 +12,24 @@ pub struct Panicky {
 
 impl Plugin for Panicky {
     fn info() -> PluginInfo {
-        PluginInfo::new("test-panicky", env!("CARGO_PKG_VERSION"), &["test-panicky"], "test fixture that panics on demand")
+        PluginInfo::new(
+            "test-panicky",
+            env!("CARGO_PKG_VERSION"),
+            &["test-panicky"],
+            "test fixture that panics on demand",
+        )
     }
 
     fn new(_host: Host, _config: &str) -> Result<Self, String> {
         Ok(Panicky { calls: 0 })
     }
 
-    fn call(&mut self, command: &str, payload: &[u8], _ctx: &CallContext<'_>) -> Result<Vec<u8>, CallError> {
+    fn call(
+        &mut self,
+        command: &str,
+        payload: &[u8],
+        _ctx: &CallContext<'_>,
+    ) -> Result<Vec<u8>, CallError> {
         self.calls += 1;
         match command {
             "panic" => panic!("asked to panic (call {})", self.calls),

@@ -11,7 +11,8 @@ use tsukami_plugin_api::{export_plugin, CallContext, CallError, Host, Plugin, Pl
 pub struct Slow;
 
 fn requested_ms(payload: &[u8]) -> Result<u64, CallError> {
-    let text = std::str::from_utf8(payload).map_err(|_| CallError::new("invalid_request", "payload is not UTF-8"))?;
+    let text = std::str::from_utf8(payload)
+        .map_err(|_| CallError::new("invalid_request", "payload is not UTF-8"))?;
     // The fixture avoids a JSON dependency: it reads the number after `"ms":`.
     let digits: String = text
         .split("\"ms\"")
@@ -21,25 +22,38 @@ fn requested_ms(payload: &[u8]) -> Result<u64, CallError> {
         .skip_while(|c| !c.is_ascii_digit())
         .take_while(|c| c.is_ascii_digit())
         .collect();
-    digits.parse().map_err(|_| CallError::new("invalid_request", "expected {\"ms\": <integer>}"))
+    digits
+        .parse()
+        .map_err(|_| CallError::new("invalid_request", "expected {\"ms\": <integer>}"))
 }
 
 impl Plugin for Slow {
     fn info() -> PluginInfo {
-        PluginInfo::new("test-slow", env!("CARGO_PKG_VERSION"), &["test-slow"], "test fixture with a slow, cancellable command")
+        PluginInfo::new(
+            "test-slow",
+            env!("CARGO_PKG_VERSION"),
+            &["test-slow"],
+            "test fixture with a slow, cancellable command",
+        )
     }
 
     fn new(_host: Host, _config: &str) -> Result<Self, String> {
         Ok(Slow)
     }
 
-    fn call(&mut self, command: &str, payload: &[u8], ctx: &CallContext<'_>) -> Result<Vec<u8>, CallError> {
+    fn call(
+        &mut self,
+        command: &str,
+        payload: &[u8],
+        ctx: &CallContext<'_>,
+    ) -> Result<Vec<u8>, CallError> {
         match command {
             "echo" => Ok(payload.to_vec()),
             "work" | "progress" => {
                 let ms = requested_ms(payload)?;
                 if command == "progress" {
-                    ctx.host().progress(b"{\"phase\":\"work\",\"fraction\":0.0}");
+                    ctx.host()
+                        .progress(b"{\"phase\":\"work\",\"fraction\":0.0}");
                 }
                 let start = Instant::now();
                 while start.elapsed() < Duration::from_millis(ms) {

@@ -1,0 +1,122 @@
+//! Runs the paper's scenes against a planner over the bus, exactly as an external
+//! client would: SetRobot, SetObject, SetEnv, Plan — and judges each reply against
+//! what the paper reports (`tsukami-scenes`). Used by `tsukami demo` and the
+//! end-to-end tests.
+
+use crate::client::BusClient;
+use serde::Serialize;
+use std::path::Path;
+use std::time::{Duration, Instant};
+use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER};
+use tsukami_msgs::planner::{ObjectSummary, PlanOptions, PlanReply, WholeBody};
+use tsukami_scenes::{scene_requests, PaperScene};
+
+/// What happened to one scene.
+#[derive(Debug, Clone, Serialize)]
+pub struct SceneOutcome {
+    /// Scene name.
+    pub scene: String,
+    /// The paper's outcome, in words.
+    pub expected: String,
+    /// Whether the outcome matches the paper.
+    pub ok: bool,
+    /// Why not, when it does not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub problem: Option<String>,
+    /// The Plan reply (absent when planning failed).
+    pub result: Option<PlanReply>,
+    /// Number of OCP regions the object split into.
+    pub regions: usize,
+    /// The error of the arm-only plan, for scenes where the paper says it fails.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub arm_only: Option<String>,
+    /// Round trip of the Plan request, milliseconds.
+    pub plan_ms: f64,
+}
+
+fn send<T: Serialize>(
+    client: &BusClient,
+    command: &str,
+    request: &T,
+    timeout: Duration,
+) -> Result<Vec<u8>, String> {
+    let payload = serde_json::to_vec(request).map_err(|e| e.to_string())?;
+    client
+        .command(ROLE_GRASP_PLANNER, command, &payload, timeout)
+        .map_err(|e| format!("{command}: {e}"))
+}
+
+/// Sets the planner up for `scene` and plans it with `seed`.
+pub fn run_scene(
+    client: &BusClient,
+    models_dir: &Path,
+    scene: &PaperScene,
+    seed: u64,
+    timeout: Duration,
+) -> SceneOutcome {
+    let mut outcome = SceneOutcome {
+        scene: scene.name.to_owned(),
+        expected: scene.expected.to_owned(),
+        ok: false,
+        problem: None,
+        result: None,
+        regions: 0,
+        arm_only: None,
+        plan_ms: 0.0,
+    };
+    if let Err(problem) = plan_scene(client, models_dir, scene, seed, timeout, &mut outcome) {
+        outcome.problem = Some(problem);
+    }
+    outcome
+}
+
+fn plan_scene(
+    client: &BusClient,
+    models_dir: &Path,
+    scene: &PaperScene,
+    seed: u64,
+    timeout: Duration,
+    outcome: &mut SceneOutcome,
+) -> Result<(), String> {
+    let file = models_dir
+        .join("scenes")
+        .join(format!("{}.toml", scene.name));
+    let requests = scene_requests(&file).map_err(|e| e.to_string())?;
+    send(client, planner::SET_ROBOT, &requests.robot, timeout)?;
+    let object: ObjectSummary = serde_json::from_slice(&send(
+        client,
+        planner::SET_OBJECT,
+        &requests.object,
+        timeout,
+    )?)
+    .map_err(|e| format!("set_object reply: {e}"))?;
+    outcome.regions = object.regions.len();
+    send(client, planner::SET_ENV, &requests.env, timeout)?;
+
+    if scene.arm_alone_fails {
+        let arm_only = PlanOptions {
+            seed,
+            whole_body: WholeBody::ArmOnly,
+            ..PlanOptions::default()
+        };
+        match send(client, planner::PLAN, &arm_only, timeout) {
+            Ok(_) => return Err("the arm alone found a grasp; the paper says it cannot".to_owned()),
+            Err(e) => outcome.arm_only = Some(e),
+        }
+    }
+
+    let options = PlanOptions {
+        seed,
+        ..PlanOptions::default()
+    };
+    let start = Instant::now();
+    let reply = send(client, planner::PLAN, &options, timeout);
+    outcome.plan_ms = start.elapsed().as_secs_f64() * 1e3;
+    let reply: PlanReply =
+        serde_json::from_slice(&reply?).map_err(|e| format!("plan reply: {e}"))?;
+    let verdict = scene.check(&reply, outcome.regions);
+    outcome.result = Some(reply);
+    verdict?;
+    outcome.ok = true;
+    Ok(())
+}

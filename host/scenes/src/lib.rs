@@ -1,0 +1,18 @@
+//! The paper's scenes as the requests an external client sends, and the outcomes the
+//! paper reports.
+//!
+//! - [`requests`]: a scene file (`models/scenes/*.toml`, `tsukami-body`'s format) →
+//!   the SetRobot / SetObject / SetEnv messages that set a planner up for it.
+//! - [`paper`]: the outcome the paper reports for each scene, as a check on a Plan
+//!   reply.
+//!
+//! The planner's own tests, the end-to-end tests over the bus and `tsukami demo`
+//! all use this crate, so the scenes are turned into messages, and judged, in one
+//! place. It sits beside `tsukami-body` and `tsukami-msgs` and does no I/O beyond
+//! reading scene and model files.
+
+pub mod paper;
+pub mod requests;
+
+pub use paper::{paper_scene, PaperScene, PAPER_SCENES};
+pub use requests::{scene_requests, SceneError, SceneRequests};

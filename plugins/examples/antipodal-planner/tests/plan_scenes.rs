@@ -1,0 +1,102 @@
+//! Plans the can scenes in-process, calling the planner directly, and checks
+//! the grasps against the exact force-closure test with the weight.
+
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+
+use nalgebra::{Point3, Vector3};
+use tsukami_antipodal_planner::AntipodalPlanner;
+use tsukami_grasp::contact::Contact;
+use tsukami_grasp::exact::{exact_test, ConeModel};
+use tsukami_grasp::grasp::Grasp;
+use tsukami_msgs::planner::{PlanOptions, PlanReply};
+
+fn models() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../models")
+}
+
+fn planner_for(scene: &str) -> AntipodalPlanner {
+    let req = tsukami_scenes::scene_requests(&models().join("scenes").join(scene)).unwrap();
+    let mut p = AntipodalPlanner::new(models());
+    p.set_robot(&req.robot).unwrap();
+    p.set_object(&req.object).unwrap();
+    p.set_env(&req.env).unwrap();
+    p
+}
+
+/// Rebuilds the grasp from the reply alone and runs the exact test.
+fn independent_exact_check(r: &PlanReply) -> bool {
+    let contacts: Vec<Contact> = r
+        .contacts
+        .iter()
+        .map(|c| Contact::new(Point3::from(c.position), Vector3::from(c.normal)).unwrap())
+        .collect();
+    let limits = r.contacts.iter().map(|c| c.f_max).collect();
+    let com = Point3::from(r.object.center_of_mass);
+    let grasp =
+        Grasp::with_force_limits(contacts, limits, r.mu, r.characteristic_length, com).unwrap();
+    let weight = grasp.weight_wrench(r.object.mass, &Vector3::new(0.0, 0.0, -9.81), &com);
+    exact_test(&grasp, ConeModel::Circular, &weight)
+        .unwrap()
+        .resists_weight()
+}
+
+fn check_scene(scene: &str) {
+    let planner = planner_for(scene);
+    let cancel = AtomicBool::new(false);
+    let mut events = 0;
+    let reply = planner
+        .plan(&PlanOptions::default(), &cancel, &mut |_| events += 1)
+        .unwrap_or_else(|e| panic!("{scene}: {e}"));
+    assert!(events >= 2, "progress events: {events}");
+    assert_eq!(reply.contacts.len(), 3);
+    assert!(reply.contacts[0].link.starts_with("r_thumb"));
+    assert!(reply.force_closure.exact_resists_weight);
+    assert!(
+        independent_exact_check(&reply),
+        "{scene}: contacts do not resist the weight"
+    );
+    assert_eq!(reply.grasp_type.name, "fingertip3_mid");
+    assert_eq!(reply.ocp_region, 0);
+    assert!(reply.joint_positions.contains_key("r_elbow"));
+    assert!(reply.joint_positions.contains_key("r_index_j2"));
+    assert!((reply.object.mass - 0.15).abs() < 1e-12);
+    assert!(reply.characteristic_length > 0.1 && reply.characteristic_length < 0.13);
+    assert!(reply.timing_ms.total > 0.0);
+    // Contacts lie on the can's surface: 33 mm from its vertical axis (or on
+    // a cap), between its bottom and its top (122 mm).
+    let req = tsukami_scenes::scene_requests(&models().join("scenes").join(scene)).unwrap();
+    let base = Vector3::from(req.object.pose.position);
+    for c in &reply.contacts {
+        assert!(c.f_max > 0.0);
+        assert!((Vector3::from(c.normal).norm() - 1.0).abs() < 1e-9);
+        let p = Vector3::from(c.position) - base;
+        let radial = p.xy().norm();
+        assert!(
+            radial < 0.0335 && p.z > -1e-3 && p.z < 0.123,
+            "{scene}: contact {p:?} not on the can"
+        );
+        assert!(
+            radial > 0.032 || p.z < 1e-3 || p.z > 0.121,
+            "{scene}: contact {p:?} inside the can"
+        );
+    }
+    eprintln!(
+        "{scene}: {} samples, {:.1} ms, face {:?}, margin {:.3}, joints_used {:?}",
+        reply.samples,
+        reply.timing_ms.total,
+        reply.face,
+        reply.force_closure.margin,
+        reply.joints_used
+    );
+}
+
+#[test]
+fn can_breast() {
+    check_scene("can_breast.toml");
+}
+
+#[test]
+fn can_waist() {
+    check_scene("can_waist.toml");
+}

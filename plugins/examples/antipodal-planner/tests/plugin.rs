@@ -1,0 +1,207 @@
+//! The plugin adapter in-process through the `Plugin` trait: JSON in, JSON
+//! out, bus error codes, state kept on bad input, progress through a
+//! recording test host, cancellation through the call's flag.
+
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex};
+
+use abi_stable::sabi_trait::TD_Opaque;
+use abi_stable::std_types::{RArc, RResult, RSlice, RStr, RString, RVec};
+use tsukami_antipodal_planner::AntipodalPlugin;
+use tsukami_msgs::planner::PlanReply;
+use tsukami_plugin_api::ffi::{FfiCallError, FfiHost, FfiHost_TO, FfiSubscriptionBox};
+use tsukami_plugin_api::{CallContext, CallError, Host, Plugin};
+use tsukami_scenes::scene_requests;
+
+#[derive(Clone, Default)]
+struct Recorder {
+    progress: Arc<Mutex<Vec<Vec<u8>>>>,
+}
+
+impl FfiHost for Recorder {
+    fn publish(&self, _key: RStr<'_>, _payload: RSlice<'_, u8>) -> RResult<(), RString> {
+        RResult::ROk(())
+    }
+    fn request(
+        &self,
+        key: RStr<'_>,
+        _p: RSlice<'_, u8>,
+        _t: u64,
+    ) -> RResult<RVec<u8>, FfiCallError> {
+        RResult::RErr(FfiCallError {
+            code: "no_plugin".into(),
+            message: format!("no bus in this test ({key})").as_str().into(),
+            details_json: "".into(),
+        })
+    }
+    fn subscribe(&self, _key: RStr<'_>) -> RResult<FfiSubscriptionBox, RString> {
+        RResult::RErr("no bus in this test".into())
+    }
+    fn log(&self, _level: u8, _message: RStr<'_>) {}
+    fn progress(&self, payload: RSlice<'_, u8>) {
+        self.progress.lock().unwrap().push(payload.to_vec());
+    }
+}
+
+fn models() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../models")
+}
+
+fn setup() -> (Recorder, Host, AntipodalPlugin) {
+    let rec = Recorder::default();
+    let host = Host::from_ffi(FfiHost_TO::from_ptr(RArc::new(rec.clone()), TD_Opaque));
+    let config = format!("models_dir = {:?}", models().display().to_string());
+    let plugin = AntipodalPlugin::new(host.clone(), &config).unwrap();
+    (rec, host, plugin)
+}
+
+fn json<T: serde::Serialize>(v: &T) -> Vec<u8> {
+    serde_json::to_vec(v).unwrap()
+}
+
+fn details(e: &CallError) -> serde_json::Value {
+    serde_json::from_str(&e.details_json).unwrap()
+}
+
+#[test]
+fn plans_can_breast_through_the_plugin_interface() {
+    let (rec, host, mut plugin) = setup();
+    let cancel = AtomicBool::new(false);
+    let ctx = CallContext::new(&cancel, &host);
+    let e = plugin.call("plan", b"{}", &ctx).unwrap_err();
+    assert_eq!(e.code, "not_ready", "{e}");
+    assert_eq!(details(&e)["missing"], "set_robot");
+
+    let req = scene_requests(&models().join("scenes/can_breast.toml")).unwrap();
+    let robot: serde_json::Value =
+        serde_json::from_slice(&plugin.call("set_robot", &json(&req.robot), &ctx).unwrap())
+            .unwrap();
+    assert_eq!(robot["arm_joints"].as_array().unwrap().len(), 7);
+    let e = plugin.call("plan", b"", &ctx).unwrap_err();
+    assert_eq!(e.code, "not_ready");
+    assert_eq!(details(&e)["missing"], "set_object");
+    let object: serde_json::Value =
+        serde_json::from_slice(&plugin.call("set_object", &json(&req.object), &ctx).unwrap())
+            .unwrap();
+    assert_eq!(object["regions"].as_array().unwrap().len(), 1);
+    plugin.call("set_env", &json(&req.env), &ctx).unwrap();
+
+    let reply: PlanReply =
+        serde_json::from_slice(&plugin.call("plan", br#"{"seed": 3}"#, &ctx).unwrap()).unwrap();
+    assert!(reply.force_closure.exact_resists_weight);
+    assert_eq!(reply.contacts.len(), 3);
+    let events = rec.progress.lock().unwrap();
+    assert!(!events.is_empty());
+    let last: serde_json::Value = serde_json::from_slice(events.last().unwrap()).unwrap();
+    assert_eq!(last["phase"], "done");
+}
+
+#[test]
+fn bad_input_names_the_field_and_keeps_state() {
+    let (_rec, host, mut plugin) = setup();
+    let cancel = AtomicBool::new(false);
+    let ctx = CallContext::new(&cancel, &host);
+    let req = scene_requests(&models().join("scenes/can_waist.toml")).unwrap();
+    plugin.call("set_robot", &json(&req.robot), &ctx).unwrap();
+    plugin.call("set_object", &json(&req.object), &ctx).unwrap();
+
+    let mut bad = req.object.clone();
+    bad.mass = -1.0;
+    let e = plugin.call("set_object", &json(&bad), &ctx).unwrap_err();
+    assert_eq!(e.code, "invalid_value");
+    assert_eq!(details(&e)["field"], "mass");
+    assert!(e.message.contains("mass"), "{e}");
+    let e = plugin.call("set_object", br#"{"shape": {"model": {"name": "can_350ml"}}, "mass": 0.1, "pose": {"position": [0, 0, 0], "quaternion": [0, 0, 0, 0]}}"#, &ctx).unwrap_err();
+    assert_eq!(e.code, "invalid_value");
+    assert_eq!(details(&e)["field"], "pose.quaternion");
+    let e = plugin.call("set_object", br#"{"shape": {"model": {"name": "teapot"}}, "mass": 0.1, "pose": {"position": [0, 0, 0]}}"#, &ctx).unwrap_err();
+    assert_eq!(e.code, "model_error");
+    assert_eq!(details(&e)["name"], "teapot");
+    let e = plugin
+        .call(
+            "set_object",
+            br#"{"shape": {"model": {"name": "can_350ml"}}, "mas": 0.1}"#,
+            &ctx,
+        )
+        .unwrap_err();
+    assert_eq!(e.code, "invalid_request");
+    let e = plugin
+        .call("set_robot", br#"{"robot": "no_such_robot"}"#, &ctx)
+        .unwrap_err();
+    assert_eq!(e.code, "model_error");
+    let e = plugin
+        .call("set_env", br#"{"obstacles": [{"name": "ok", "shape": {"sphere": {"radius": 0.1}}, "pose": {"position": [2, 0, 0]}}, {"name": "flat", "shape": {"box": {"size": [1, 0, 1]}}, "pose": {"position": [0, 0, 0]}}]}"#, &ctx)
+        .unwrap_err();
+    assert_eq!(e.code, "invalid_value");
+    assert_eq!(details(&e)["field"], "obstacles[1].shape");
+    let e = plugin
+        .call("remove_env", br#"{"names": ["ghost"]}"#, &ctx)
+        .unwrap_err();
+    assert_eq!(e.code, "invalid_value");
+    assert_eq!(details(&e)["field"], "names[0]");
+    let e = plugin
+        .call("plan", br#"{"max_samples": 0}"#, &ctx)
+        .unwrap_err();
+    assert_eq!(e.code, "invalid_value");
+    assert_eq!(details(&e)["field"], "max_samples");
+    let e = plugin
+        .call("plan", br#"{"grasp_types": ["envelope4_large"]}"#, &ctx)
+        .unwrap_err();
+    assert_eq!(e.code, "infeasible");
+    let e = plugin.call("fly", b"{}", &ctx).unwrap_err();
+    assert_eq!(e.code, "unknown_command");
+
+    // None of the bad requests changed the state: no obstacle was added
+    // (the half-valid set_env added nothing) and the can still plans.
+    let env: serde_json::Value = serde_json::from_slice(
+        &plugin
+            .call("remove_env", br#"{"all": true}"#, &ctx)
+            .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(env["obstacles"].as_array().unwrap().len(), 0);
+    plugin.call("set_env", &json(&req.env), &ctx).unwrap();
+    let reply: PlanReply =
+        serde_json::from_slice(&plugin.call("plan", b"{}", &ctx).unwrap()).unwrap();
+    assert!(
+        (reply.object.mass - 0.15).abs() < 1e-12,
+        "object was replaced by a bad request"
+    );
+    assert!(reply.force_closure.exact_resists_weight);
+}
+
+#[test]
+fn a_raised_cancel_flag_stops_the_plan() {
+    let (_rec, host, mut plugin) = setup();
+    let cancel = AtomicBool::new(false);
+    let ctx = CallContext::new(&cancel, &host);
+    let req = scene_requests(&models().join("scenes/can_breast.toml")).unwrap();
+    plugin.call("set_robot", &json(&req.robot), &ctx).unwrap();
+    plugin.call("set_object", &json(&req.object), &ctx).unwrap();
+    cancel.store(true, std::sync::atomic::Ordering::Relaxed);
+    let e = plugin.call("plan", b"{}", &ctx).unwrap_err();
+    assert_eq!(e.code, "cancelled", "{e}");
+}
+
+#[test]
+fn an_unreachable_object_is_infeasible() {
+    let (_rec, host, mut plugin) = setup();
+    let cancel = AtomicBool::new(false);
+    let ctx = CallContext::new(&cancel, &host);
+    let req = scene_requests(&models().join("scenes/can_breast.toml")).unwrap();
+    plugin.call("set_robot", &json(&req.robot), &ctx).unwrap();
+    let mut far = req.object.clone();
+    far.pose.position = [3.0, -0.25, 1.1];
+    plugin.call("set_object", &json(&far), &ctx).unwrap();
+    let e = plugin
+        .call(
+            "plan",
+            br#"{"max_samples": 20, "whole_body": "arm_only"}"#,
+            &ctx,
+        )
+        .unwrap_err();
+    assert_eq!(e.code, "infeasible", "{e}");
+    assert_eq!(details(&e)["samples"], 20);
+    assert!(e.message.contains("out of reach"), "{e}");
+}

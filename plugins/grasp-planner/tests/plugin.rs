@@ -1,0 +1,97 @@
+//! The plugin adapter in-process: JSON in, JSON out, bus error codes, progress
+//! events through the host handle (a recording test host; no bus).
+
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex};
+
+use abi_stable::sabi_trait::TD_Opaque;
+use abi_stable::std_types::{RResult, RSlice, RStr, RString, RVec};
+use tsukami_grasp_planner::plugin::GraspPlannerPlugin;
+use tsukami_plugin_api::ffi::{FfiCallError, FfiHost, FfiHost_TO, FfiSubscriptionBox};
+use tsukami_plugin_api::{CallContext, Host, Plugin};
+use tsukami_scenes::scene_requests;
+
+#[derive(Clone, Default)]
+struct Recorder {
+    progress: Arc<Mutex<Vec<Vec<u8>>>>,
+}
+
+impl FfiHost for Recorder {
+    fn publish(&self, _key: RStr<'_>, _payload: RSlice<'_, u8>) -> RResult<(), RString> {
+        RResult::ROk(())
+    }
+    fn request(
+        &self,
+        key: RStr<'_>,
+        _p: RSlice<'_, u8>,
+        _t: u64,
+    ) -> RResult<RVec<u8>, FfiCallError> {
+        RResult::RErr(FfiCallError {
+            code: "no_plugin".into(),
+            message: format!("no bus in this test ({key})").as_str().into(),
+            details_json: "".into(),
+        })
+    }
+    fn subscribe(&self, _key: RStr<'_>) -> RResult<FfiSubscriptionBox, RString> {
+        RResult::RErr("no bus in this test".into())
+    }
+    fn log(&self, _level: u8, _message: RStr<'_>) {}
+    fn progress(&self, payload: RSlice<'_, u8>) {
+        self.progress.lock().unwrap().push(payload.to_vec());
+    }
+}
+
+#[test]
+fn plans_the_can_through_the_plugin_interface() {
+    let rec = Recorder::default();
+    let host = Host::from_ffi(FfiHost_TO::from_ptr(
+        abi_stable::std_types::RArc::new(rec.clone()),
+        TD_Opaque,
+    ));
+    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let config = format!("models_dir = {:?}", models.display().to_string());
+    let mut plugin = GraspPlannerPlugin::new(host.clone(), &config).unwrap();
+    let cancel = AtomicBool::new(false);
+    let ctx = CallContext::new(&cancel, &host);
+    let mut call = |c: &str, body: &str| plugin.call(c, body.as_bytes(), &ctx);
+
+    // Plan before anything is set: not_ready, with the planner's reason.
+    let e = call("plan", "{}").unwrap_err();
+    assert_eq!(e.code, "not_ready");
+    assert!(e.details_json.contains("no_robot"), "{}", e.details_json);
+    // A misspelt field is refused by name.
+    let e = call("set_robot", r#"{"robt": "tsukami_humanoid"}"#).unwrap_err();
+    assert_eq!(e.code, "invalid_request");
+
+    let req = scene_requests(&models.join("scenes/can_breast.toml")).unwrap();
+    let robot: serde_json::Value = serde_json::from_slice(
+        &call("set_robot", &serde_json::to_string(&req.robot).unwrap()).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(robot["grasp_types"].as_array().unwrap().len(), 9);
+    let obj: serde_json::Value = serde_json::from_slice(
+        &call("set_object", &serde_json::to_string(&req.object).unwrap()).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(obj["regions"].as_array().unwrap().len(), 1);
+    call("set_env", &serde_json::to_string(&req.env).unwrap()).unwrap();
+    let reply: serde_json::Value =
+        serde_json::from_slice(&call("plan", r#"{"seed": 3}"#).unwrap()).unwrap();
+    assert_eq!(reply["grasp_type"]["style"], "fingertip4");
+    assert_eq!(
+        reply["palm_pose"]["quaternion"].as_array().unwrap().len(),
+        4
+    );
+    assert_eq!(reply["force_closure"]["exact_resists_weight"], true);
+    assert!(reply["timing_ms"]["total"].as_f64().unwrap() > 0.0);
+    let events = rec.progress.lock().unwrap();
+    assert!(!events.is_empty());
+    let last: serde_json::Value = serde_json::from_slice(events.last().unwrap()).unwrap();
+    assert_eq!(last["phase"], "done");
+
+    assert_eq!(
+        call("frobnicate", "{}").unwrap_err().code,
+        "unknown_command"
+    );
+}
