@@ -22,7 +22,7 @@
 //! crate needs `crate-type = ["cdylib", "rlib"]` and `abi_stable` as a dependency
 //! (the export macro expands to abi_stable's root-module export).
 //!
-//! ```ignore
+//! ```no_run
 //! use tsukami_plugin_api::{export_plugin, CallContext, CallError, Host, Plugin, PluginInfo};
 //!
 //! pub struct Echo;

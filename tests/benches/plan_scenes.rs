@@ -1,0 +1,61 @@
+//! Time to plan each of the paper's scenes, p50 over seeds, in-process (the planner
+//! library called directly) and over the bus (a client → the host → the plugin file),
+//! in the same run, with the ratio.
+//!
+//! Run: `cargo bench -p tsukami-e2e --bench plan_scenes`. Targets (issue #5): can at
+//! breast height p50 < 10 ms in-process; fridge scene p50 < 100 ms.
+
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+use tsukami_e2e::{models_dir, planner_entry, test_config, TestBus};
+use tsukami_grasp_planner::planner::Planner;
+use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER};
+use tsukami_msgs::planner::PlanOptions;
+use tsukami_scenes::{scene_requests, PAPER_SCENES};
+
+const SEEDS: u64 = 32;
+const T: Duration = Duration::from_secs(60);
+
+fn median_ms(mut times: Vec<Duration>) -> f64 {
+    times.sort();
+    times[times.len() / 2].as_secs_f64() * 1e3
+}
+
+fn main() {
+    let bus = TestBus::start(test_config(vec![planner_entry()]));
+    let send = |command: &str, body: Vec<u8>| bus.client.command(ROLE_GRASP_PLANNER, command, &body, T).expect(command);
+
+    println!("plan time per scene, p50 over {SEEDS} seeds (release):");
+    println!("{:<11} {:>14} {:>14} {:>8}", "scene", "in-process ms", "over bus ms", "bus/in");
+    for scene in PAPER_SCENES {
+        let req = scene_requests(&models_dir().join("scenes").join(format!("{}.toml", scene.name))).unwrap();
+
+        let mut local = Planner::new(models_dir());
+        local.set_robot(&req.robot).unwrap();
+        local.set_object(&req.object).unwrap();
+        local.set_env(&req.env).unwrap();
+        let in_process: Vec<Duration> = (0..SEEDS)
+            .map(|seed| {
+                let options = PlanOptions { seed, ..PlanOptions::default() };
+                let start = Instant::now();
+                local.plan(&options, &AtomicBool::new(false), &mut |_| {}).expect("plan");
+                start.elapsed()
+            })
+            .collect();
+
+        send(planner::SET_ROBOT, serde_json::to_vec(&req.robot).unwrap());
+        send(planner::SET_OBJECT, serde_json::to_vec(&req.object).unwrap());
+        send(planner::SET_ENV, serde_json::to_vec(&req.env).unwrap());
+        let over_bus: Vec<Duration> = (0..SEEDS)
+            .map(|seed| {
+                let body = serde_json::to_vec(&PlanOptions { seed, ..PlanOptions::default() }).unwrap();
+                let start = Instant::now();
+                send(planner::PLAN, body);
+                start.elapsed()
+            })
+            .collect();
+
+        let (a, b) = (median_ms(in_process), median_ms(over_bus));
+        println!("{:<11} {:>14.2} {:>14.2} {:>7.2}x", scene.name, a, b, b / a);
+    }
+}
