@@ -167,13 +167,17 @@ impl HostConfig {
         if given.parent().is_some_and(|p| !p.as_os_str().is_empty()) {
             return Ok(self.base_dir.join(given.with_file_name(file_name)));
         }
-        let candidates = plugin_search_dirs()
+        let tried: Vec<PathBuf> = plugin_search_dirs()
             .into_iter()
-            .map(|dir| dir.join(&file_name));
-        let tried: Vec<PathBuf> = candidates.collect();
+            .map(|dir| dir.join(&file_name))
+            .collect();
+        // Cargo leaves a copy in the profile folder (`cargo build -p plugin`) and one in
+        // `deps/` (when it is built as a dependency); the newer one is the current build.
+        let modified = |p: &&PathBuf| std::fs::metadata(p).and_then(|m| m.modified()).ok();
         tried
             .iter()
-            .find(|p| p.is_file())
+            .filter(|p| p.is_file())
+            .max_by_key(modified)
             .cloned()
             .with_context(|| format!("plugin library `{file_name}` for role `{}` not found; looked in {tried:?} (build it with `cargo build --workspace`)", entry.role))
     }
