@@ -23,12 +23,24 @@ fn median_ms(mut times: Vec<Duration>) -> f64 {
 
 fn main() {
     let bus = TestBus::start(test_config(vec![planner_entry()]));
-    let send = |command: &str, body: Vec<u8>| bus.client.command(ROLE_GRASP_PLANNER, command, &body, T).expect(command);
+    let send = |command: &str, body: Vec<u8>| {
+        bus.client
+            .command(ROLE_GRASP_PLANNER, command, &body, T)
+            .expect(command)
+    };
 
     println!("plan time per scene, p50 over {SEEDS} seeds (release):");
-    println!("{:<11} {:>14} {:>14} {:>8}", "scene", "in-process ms", "over bus ms", "bus/in");
+    println!(
+        "{:<11} {:>14} {:>14} {:>8}",
+        "scene", "in-process ms", "over bus ms", "bus/in"
+    );
     for scene in PAPER_SCENES {
-        let req = scene_requests(&models_dir().join("scenes").join(format!("{}.toml", scene.name))).unwrap();
+        let req = scene_requests(
+            &models_dir()
+                .join("scenes")
+                .join(format!("{}.toml", scene.name)),
+        )
+        .unwrap();
 
         let mut local = Planner::new(models_dir());
         local.set_robot(&req.robot).unwrap();
@@ -36,19 +48,31 @@ fn main() {
         local.set_env(&req.env).unwrap();
         let in_process: Vec<Duration> = (0..SEEDS)
             .map(|seed| {
-                let options = PlanOptions { seed, ..PlanOptions::default() };
+                let options = PlanOptions {
+                    seed,
+                    ..PlanOptions::default()
+                };
                 let start = Instant::now();
-                local.plan(&options, &AtomicBool::new(false), &mut |_| {}).expect("plan");
+                local
+                    .plan(&options, &AtomicBool::new(false), &mut |_| {})
+                    .expect("plan");
                 start.elapsed()
             })
             .collect();
 
         send(planner::SET_ROBOT, serde_json::to_vec(&req.robot).unwrap());
-        send(planner::SET_OBJECT, serde_json::to_vec(&req.object).unwrap());
+        send(
+            planner::SET_OBJECT,
+            serde_json::to_vec(&req.object).unwrap(),
+        );
         send(planner::SET_ENV, serde_json::to_vec(&req.env).unwrap());
         let over_bus: Vec<Duration> = (0..SEEDS)
             .map(|seed| {
-                let body = serde_json::to_vec(&PlanOptions { seed, ..PlanOptions::default() }).unwrap();
+                let body = serde_json::to_vec(&PlanOptions {
+                    seed,
+                    ..PlanOptions::default()
+                })
+                .unwrap();
                 let start = Instant::now();
                 send(planner::PLAN, body);
                 start.elapsed()

@@ -90,8 +90,8 @@ pub fn run(args: &DemoArgs) -> Result<ExitCode> {
 
 fn print_table(outcomes: &[SceneOutcome]) {
     println!(
-        "{:<11} {:<16} {:<6} {:<31} {:>7} {:>6} {:>9}  {}",
-        "scene", "grasp type", "face", "whole-body joints", "margin", "exact", "plan ms", "paper"
+        "{:<11} {:<16} {:<6} {:<31} {:>7} {:>6} {:>9}  paper",
+        "scene", "grasp type", "face", "whole-body joints", "margin", "exact", "plan ms"
     );
     for o in outcomes {
         let (grasp, face, joints, margin, exact) = match &o.result {

@@ -43,6 +43,7 @@
 //! }
 //!
 //! export_plugin!(Echo);
+//! # fn main() {}
 //! ```
 //!
 //! # Lifecycle
