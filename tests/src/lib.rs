@@ -61,10 +61,13 @@ pub fn models_dir() -> PathBuf {
 
 /// A config entry loading the built-in grasp planner with the repository's models.
 pub fn planner_entry() -> PluginEntryConfig {
-    let mut entry = plugin_entry(
-        tsukami_msgs::keys::ROLE_GRASP_PLANNER,
-        "tsukami_grasp_planner",
-    );
+    grasp_planner_entry("tsukami_grasp_planner")
+}
+
+/// A config entry filling the `grasp-planner` role with plugin `lib_name`, handing it
+/// the repository's models (`models_dir`).
+pub fn grasp_planner_entry(lib_name: &str) -> PluginEntryConfig {
+    let mut entry = plugin_entry(tsukami_msgs::keys::ROLE_GRASP_PLANNER, lib_name);
     let mut table = toml::Table::new();
     table.insert(
         "models_dir".into(),
@@ -154,4 +157,27 @@ pub fn spawn_tsukami(args: &[&str]) -> ChildGuard {
         .spawn()
         .expect("spawning tsukami");
     ChildGuard(child)
+}
+
+/// Runs `tsukami plugins` against `endpoint` until a host answers (a query sent before
+/// the host's queryable exists goes unanswered), and returns the parsed listing.
+pub fn cli_plugins_listing(endpoint: &str, namespace: &str) -> serde_json::Value {
+    for _ in 0..60 {
+        let out = Command::new(tsukami_exe())
+            .args([
+                "plugins",
+                "--connect",
+                endpoint,
+                "--namespace",
+                namespace,
+                "--timeout-ms",
+                "500",
+            ])
+            .output()
+            .expect("running tsukami plugins");
+        if out.status.success() {
+            return serde_json::from_slice(&out.stdout).expect("tsukami plugins prints JSON");
+        }
+    }
+    panic!("`tsukami plugins` never got an answer from {endpoint}");
 }

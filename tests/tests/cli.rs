@@ -1,7 +1,7 @@
 //! The `tsukami` binary: `tsukami run` serving, `tsukami plugins` listing it.
 
 use tsukami::bus::free_loopback_port;
-use tsukami_e2e::{plugin_file, spawn_tsukami, tsukami_exe};
+use tsukami_e2e::{cli_plugins_listing, plugin_file, spawn_tsukami, tsukami_exe};
 
 #[test]
 fn plugins_lists_what_a_running_host_serves() {
@@ -27,27 +27,7 @@ fn plugins_lists_what_a_running_host_serves() {
         &namespace,
     ]);
 
-    // Ask until the host is up (a query before its queryable exists goes unanswered).
-    let mut listing = None;
-    for _ in 0..40 {
-        let out = std::process::Command::new(tsukami_exe())
-            .args([
-                "plugins",
-                "--connect",
-                &endpoint,
-                "--namespace",
-                &namespace,
-                "--timeout-ms",
-                "500",
-            ])
-            .output()
-            .unwrap();
-        if out.status.success() {
-            listing = Some(serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap());
-            break;
-        }
-    }
-    let listing = listing.expect("tsukami plugins never got an answer");
+    let listing = cli_plugins_listing(&endpoint, &namespace);
     assert_eq!(listing["namespace"], namespace.as_str());
     assert_eq!(listing["plugins"][0]["roles"][0], "test-slow");
     assert_eq!(listing["plugins"][0]["name"], "test-slow");

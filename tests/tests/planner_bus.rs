@@ -4,7 +4,9 @@
 
 use std::time::{Duration, Instant};
 use tsukami::client::{BusClient, RequestError};
-use tsukami_e2e::{models_dir, planner_entry, spawn_tsukami, test_config, tsukami_exe, TestBus};
+use tsukami_e2e::{
+    cli_plugins_listing, models_dir, planner_entry, spawn_tsukami, test_config, TestBus,
+};
 use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER};
 use tsukami_msgs::ErrorCode;
 use tsukami_scenes::scene_requests;
@@ -133,26 +135,7 @@ fn the_default_config_serves_the_planner_found_beside_the_executable() {
     let endpoint = format!("tcp/127.0.0.1:{port}");
     let namespace = format!("default-{port}");
     let _host = spawn_tsukami(&["run", "--listen", &endpoint, "--namespace", &namespace]);
-    let mut listing = None;
-    for _ in 0..60 {
-        let out = std::process::Command::new(tsukami_exe())
-            .args([
-                "plugins",
-                "--connect",
-                &endpoint,
-                "--namespace",
-                &namespace,
-                "--timeout-ms",
-                "500",
-            ])
-            .output()
-            .unwrap();
-        if out.status.success() {
-            listing = Some(serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap());
-            break;
-        }
-    }
-    let listing = listing.expect("the default host never answered");
+    let listing = cli_plugins_listing(&endpoint, &namespace);
     let plugins = listing["plugins"].as_array().unwrap();
     let planner = plugins
         .iter()

@@ -3,7 +3,7 @@
 //! `host/` crates) fills the `grasp-planner` role and plans the can scene over the bus.
 
 use std::time::Duration;
-use tsukami_e2e::{models_dir, plugin_entry, test_config, TestBus};
+use tsukami_e2e::{grasp_planner_entry, models_dir, test_config, TestBus};
 use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER};
 use tsukami_msgs::planner::PlanReply;
 use tsukami_scenes::scene_requests;
@@ -12,13 +12,7 @@ const T: Duration = Duration::from_secs(60);
 
 #[test]
 fn the_example_planner_fills_the_grasp_planner_role_by_config_alone() {
-    let mut entry = plugin_entry(ROLE_GRASP_PLANNER, "tsukami_antipodal_planner");
-    let mut table = toml::Table::new();
-    table.insert(
-        "models_dir".into(),
-        models_dir().display().to_string().into(),
-    );
-    entry.config = Some(table);
+    let entry = grasp_planner_entry("tsukami_antipodal_planner");
     let bus = TestBus::start(test_config(vec![entry]));
     let c = &bus.client;
 
