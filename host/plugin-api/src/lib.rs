@@ -58,6 +58,7 @@
 mod export;
 pub mod ffi;
 pub mod loader;
+pub mod offline;
 mod safe;
 
 pub use safe::{CallContext, CallError, Host, LogLevel, Plugin, PluginInfo, Subscription};

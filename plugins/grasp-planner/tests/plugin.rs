@@ -3,52 +3,16 @@
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
-use std::sync::{Arc, Mutex};
 
-use abi_stable::sabi_trait::TD_Opaque;
-use abi_stable::std_types::{RResult, RSlice, RStr, RString, RVec};
 use tsukami_grasp_planner::plugin::GraspPlannerPlugin;
-use tsukami_plugin_api::ffi::{FfiCallError, FfiHost, FfiHost_TO, FfiSubscriptionBox};
-use tsukami_plugin_api::{CallContext, Host, Plugin};
+use tsukami_plugin_api::offline::OfflineHost;
+use tsukami_plugin_api::{CallContext, Plugin};
 use tsukami_scenes::scene_requests;
-
-#[derive(Clone, Default)]
-struct Recorder {
-    progress: Arc<Mutex<Vec<Vec<u8>>>>,
-}
-
-impl FfiHost for Recorder {
-    fn publish(&self, _key: RStr<'_>, _payload: RSlice<'_, u8>) -> RResult<(), RString> {
-        RResult::ROk(())
-    }
-    fn request(
-        &self,
-        key: RStr<'_>,
-        _p: RSlice<'_, u8>,
-        _t: u64,
-    ) -> RResult<RVec<u8>, FfiCallError> {
-        RResult::RErr(FfiCallError {
-            code: "no_plugin".into(),
-            message: format!("no bus in this test ({key})").as_str().into(),
-            details_json: "".into(),
-        })
-    }
-    fn subscribe(&self, _key: RStr<'_>) -> RResult<FfiSubscriptionBox, RString> {
-        RResult::RErr("no bus in this test".into())
-    }
-    fn log(&self, _level: u8, _message: RStr<'_>) {}
-    fn progress(&self, payload: RSlice<'_, u8>) {
-        self.progress.lock().unwrap().push(payload.to_vec());
-    }
-}
 
 #[test]
 fn plans_the_can_through_the_plugin_interface() {
-    let rec = Recorder::default();
-    let host = Host::from_ffi(FfiHost_TO::from_ptr(
-        abi_stable::std_types::RArc::new(rec.clone()),
-        TD_Opaque,
-    ));
+    let offline = OfflineHost::new();
+    let host = offline.host();
     let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
     let config = format!("models_dir = {:?}", models.display().to_string());
     let mut plugin = GraspPlannerPlugin::new(host.clone(), &config).unwrap();
@@ -85,7 +49,7 @@ fn plans_the_can_through_the_plugin_interface() {
     );
     assert_eq!(reply["force_closure"]["exact_resists_weight"], true);
     assert!(reply["timing_ms"]["total"].as_f64().unwrap() > 0.0);
-    let events = rec.progress.lock().unwrap();
+    let events = offline.progress();
     assert!(!events.is_empty());
     let last: serde_json::Value = serde_json::from_slice(events.last().unwrap()).unwrap();
     assert_eq!(last["phase"], "done");

@@ -4,53 +4,20 @@
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
-use std::sync::{Arc, Mutex};
 
-use abi_stable::sabi_trait::TD_Opaque;
-use abi_stable::std_types::{RArc, RResult, RSlice, RStr, RString, RVec};
 use tsukami_antipodal_planner::AntipodalPlugin;
 use tsukami_msgs::planner::PlanReply;
-use tsukami_plugin_api::ffi::{FfiCallError, FfiHost, FfiHost_TO, FfiSubscriptionBox};
+use tsukami_plugin_api::offline::OfflineHost;
 use tsukami_plugin_api::{CallContext, CallError, Host, Plugin};
 use tsukami_scenes::scene_requests;
-
-#[derive(Clone, Default)]
-struct Recorder {
-    progress: Arc<Mutex<Vec<Vec<u8>>>>,
-}
-
-impl FfiHost for Recorder {
-    fn publish(&self, _key: RStr<'_>, _payload: RSlice<'_, u8>) -> RResult<(), RString> {
-        RResult::ROk(())
-    }
-    fn request(
-        &self,
-        key: RStr<'_>,
-        _p: RSlice<'_, u8>,
-        _t: u64,
-    ) -> RResult<RVec<u8>, FfiCallError> {
-        RResult::RErr(FfiCallError {
-            code: "no_plugin".into(),
-            message: format!("no bus in this test ({key})").as_str().into(),
-            details_json: "".into(),
-        })
-    }
-    fn subscribe(&self, _key: RStr<'_>) -> RResult<FfiSubscriptionBox, RString> {
-        RResult::RErr("no bus in this test".into())
-    }
-    fn log(&self, _level: u8, _message: RStr<'_>) {}
-    fn progress(&self, payload: RSlice<'_, u8>) {
-        self.progress.lock().unwrap().push(payload.to_vec());
-    }
-}
 
 fn models() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../models")
 }
 
-fn setup() -> (Recorder, Host, AntipodalPlugin) {
-    let rec = Recorder::default();
-    let host = Host::from_ffi(FfiHost_TO::from_ptr(RArc::new(rec.clone()), TD_Opaque));
+fn setup() -> (OfflineHost, Host, AntipodalPlugin) {
+    let rec = OfflineHost::new();
+    let host = rec.host();
     let config = format!("models_dir = {:?}", models().display().to_string());
     let plugin = AntipodalPlugin::new(host.clone(), &config).unwrap();
     (rec, host, plugin)
@@ -91,7 +58,7 @@ fn plans_can_breast_through_the_plugin_interface() {
         serde_json::from_slice(&plugin.call("plan", br#"{"seed": 3}"#, &ctx).unwrap()).unwrap();
     assert!(reply.force_closure.exact_resists_weight);
     assert_eq!(reply.contacts.len(), 3);
-    let events = rec.progress.lock().unwrap();
+    let events = rec.progress();
     assert!(!events.is_empty());
     let last: serde_json::Value = serde_json::from_slice(events.last().unwrap()).unwrap();
     assert_eq!(last["phase"], "done");
