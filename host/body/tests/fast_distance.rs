@@ -104,47 +104,13 @@ fn assert_same(fast: &Proximity, parry: &Proximity, what: &str) {
     );
 }
 
-/// Closest point of triangle `abc` to `p` (Ericson §5.1.5).
-fn closest_on_triangle(p: Vector3<f64>, t: &[Vector3<f64>; 3]) -> Vector3<f64> {
-    let [a, b, c] = *t;
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    a + ab * (vb * denom) + ac * (vc * denom)
-}
-
 /// Distance from segment `[p, q]` to a triangle: the distance from a point
 /// of the segment to the triangle is convex along it, so a golden-section
 /// search over the segment finds its minimum (to ~1e-15 m here).
 fn segment_triangle_distance(p: Vector3<f64>, q: Vector3<f64>, t: &[Vector3<f64>; 3]) -> f64 {
     let f = |s: f64| {
         let x = p + (q - p) * s;
-        (closest_on_triangle(x, t) - x).norm()
+        (common::closest_on_triangle(x, t) - x).norm()
     };
     let g = (5f64.sqrt() - 1.0) / 2.0;
     let (mut lo, mut hi) = (0.0, 1.0);
@@ -198,7 +164,7 @@ fn brute_force(
     for k in 0..mesh.indices.len() {
         let t = mesh.triangle(k).map(|v| (pose * v).coords);
         // Skip triangles that cannot beat the best so far.
-        if (closest_on_triangle(mid, &t) - mid).norm() - half >= best {
+        if (common::closest_on_triangle(mid, &t) - mid).norm() - half >= best {
             continue;
         }
         best = best.min(segment_triangle_distance(p, q, &t));
