@@ -3,6 +3,7 @@
 //!
 //! - [`requests`]: a scene file (`models/scenes/*.toml`, `tsukami-body`'s format) →
 //!   the SetRobot / SetObject / SetEnv messages that set a planner up for it.
+//! - [`geometry`]: message poses and `set_env` obstacles as `tsukami-body` geometry.
 //! - [`paper`]: the outcome the paper reports for each scene, as a check on a Plan
 //!   reply.
 //!
@@ -11,6 +12,7 @@
 //! place. It sits beside `tsukami-body` and `tsukami-msgs` and does no I/O beyond
 //! reading scene and model files.
 
+pub mod geometry;
 pub mod paper;
 pub mod requests;
 

@@ -37,20 +37,19 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 use std::time::{Duration, Instant};
+use tsukami_scenes::geometry::{build_obstacle, pose_to_isometry};
 
-use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
-use tsukami_body::collision::{CollisionObject, Part};
+use nalgebra::{Isometry3, Point3, Vector3};
+use tsukami_body::collision::CollisionObject;
 use tsukami_body::ik::{IkOptions, IkSolver};
 use tsukami_body::kinematics::JointSelection;
 use tsukami_body::mesh::TriangleMesh;
-use tsukami_body::model::Geometry;
 use tsukami_body::object::ObjectModel;
 use tsukami_msgs::planner::{
     ContactReply, EnvSummary, ForceClosureReply, ObjectMass, ObjectShape, ObjectSummary,
-    ObstacleShape, PhaseTiming, PlanOptions, PlanPhase, PlanReply, Pose, ProgressEvent, RemoveEnv,
-    RobotSummary, SetEnv, SetObject, SetRobot,
+    PhaseTiming, PlanOptions, PlanPhase, PlanReply, Pose, ProgressEvent, RemoveEnv, RobotSummary,
+    SetEnv, SetObject, SetRobot,
 };
 
 use crate::hand::HandModel;
@@ -197,25 +196,7 @@ struct Nominal {
 }
 
 fn pose_to_iso(p: &Pose, field: &str) -> Result<Isometry3<f64>, String> {
-    let [x, y, z, w] = p.quaternion;
-    if !p
-        .position
-        .iter()
-        .chain(p.quaternion.iter())
-        .all(|v| v.is_finite())
-    {
-        return Err(format!(
-            "{field}: position and quaternion must be finite (got NaN or infinity)"
-        ));
-    }
-    let q = Quaternion::new(w, x, y, z);
-    if q.norm() < 1e-9 {
-        return Err(format!("{field}: quaternion has zero norm"));
-    }
-    Ok(Isometry3::from_parts(
-        Translation3::new(p.position[0], p.position[1], p.position[2]),
-        UnitQuaternion::from_quaternion(q),
-    ))
+    pose_to_isometry(p).map_err(|m| format!("{field}.{m}"))
 }
 
 fn iso_to_pose(i: &Isometry3<f64>) -> Pose {
@@ -409,57 +390,11 @@ impl Planner {
     pub fn set_env(&mut self, req: &SetEnv) -> Result<EnvSummary, PlanError> {
         let mut built = Vec::new();
         for o in &req.obstacles {
-            let bad = |m: String| PlanError::Env {
+            let object = build_obstacle(o).map_err(|e| PlanError::Env {
                 name: o.name.clone(),
-                message: m,
-            };
-            if o.name.is_empty() {
-                return Err(bad("name must not be empty".into()));
-            }
-            let pose = pose_to_iso(&o.pose, "pose").map_err(bad)?;
-            let positive = |v: &[f64]| v.iter().all(|x| x.is_finite() && *x > 0.0);
-            let geometry = match &o.shape {
-                ObstacleShape::Box { size } if positive(size) => Geometry::Box {
-                    size: Vector3::from(*size),
-                },
-                ObstacleShape::Cylinder { radius, height } if positive(&[*radius, *height]) => {
-                    Geometry::Cylinder {
-                        radius: *radius,
-                        length: *height,
-                    }
-                }
-                ObstacleShape::Capsule { radius, length }
-                    if positive(&[*radius]) && *length >= 0.0 =>
-                {
-                    Geometry::Capsule {
-                        radius: *radius,
-                        length: *length,
-                    }
-                }
-                ObstacleShape::Sphere { radius } if positive(&[*radius]) => {
-                    Geometry::Sphere { radius: *radius }
-                }
-                ObstacleShape::Mesh { path, scale } => {
-                    let s = scale.unwrap_or(1.0);
-                    if !(s.is_finite() && s > 0.0) {
-                        return Err(bad(format!("shape.mesh.scale: {s} must be > 0")));
-                    }
-                    let mesh = TriangleMesh::load(Path::new(path), Vector3::repeat(s))
-                        .map_err(|e| bad(e.to_string()))?;
-                    Geometry::Mesh {
-                        path: PathBuf::from(path),
-                        scale: Vector3::repeat(s),
-                        mesh: Arc::new(mesh),
-                    }
-                }
-                _ => return Err(bad("shape dimensions must be finite and > 0".into())),
-            };
-            let part = Part::from_geometry(&Isometry3::identity(), &geometry)
-                .map_err(|e| bad(e.to_string()))?;
-            built.push((
-                o.name.clone(),
-                CollisionObject::new(o.name.clone(), pose, vec![part]),
-            ));
+                message: e.to_string(),
+            })?;
+            built.push((o.name.clone(), object));
         }
         if req.replace {
             self.env.clear();

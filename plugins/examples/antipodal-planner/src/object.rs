@@ -11,7 +11,7 @@
 //! How: build it with [`PlanObject::new`] from a loaded
 //! [`TriangleMesh`]; every bad value is an error naming the request field.
 
-use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use tsukami_body::collision::CollisionObject;
 use tsukami_body::mesh::TriangleMesh;
 use tsukami_msgs::planner::{BoxFace, FaceBlock, OcpBox, Pose};
@@ -46,27 +46,15 @@ pub struct PlanObject {
 /// Checks a message pose (finite, unit-ish quaternion) and converts it;
 /// errors name `field`.
 pub fn pose_to_isometry(pose: &Pose, field: &str) -> Result<Isometry3<f64>, PlanError> {
-    pose.validate().map_err(|part| {
-        PlanError::invalid(
-            format!("{field}.{part}"),
-            "must be finite (and the quaternion of unit norm)",
-        )
-    })?;
-    let [x, y, z, w] = pose.quaternion;
-    let q = UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z));
-    Ok(Isometry3::from_parts(
-        Translation3::from(Vector3::from(pose.position)),
-        q,
-    ))
+    tsukami_scenes::geometry::pose_to_isometry(pose).map_err(|message| {
+        let (part, why) = message.split_once(": ").unwrap_or(("", message.as_str()));
+        PlanError::invalid(format!("{field}.{part}"), why)
+    })
 }
 
 /// Converts an isometry to a message pose.
 pub fn isometry_to_pose(iso: &Isometry3<f64>) -> Pose {
-    let q = iso.rotation;
-    Pose {
-        position: [iso.translation.x, iso.translation.y, iso.translation.z],
-        quaternion: [q.i, q.j, q.k, q.w],
-    }
+    tsukami_scenes::geometry::isometry_to_pose(iso)
 }
 
 /// Centroid of the volume enclosed by a closed, outward-oriented mesh
