@@ -111,7 +111,7 @@ pub enum PlanError {
     #[error("no grasp type fits the object's size and mass: {0}")]
     NoGraspType(String),
     /// No nominal palm pose has an IK solution, even with the whole body.
-    #[error("object unreachable even with {0}: no nominal palm pose has an IK solution")]
+    #[error("object unreachable with {0}: no nominal palm pose has an IK solution")]
     Unreachable(String),
     /// Reachable, but Algorithm 1 found no collision-free force-closure grasp.
     #[error("no force-closure grasp within the budget ({samples} samples, best margin {best_margin}; rejections: {rejections})")]
