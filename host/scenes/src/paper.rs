@@ -3,7 +3,10 @@
 //! One table serves the planner's in-process tests, the end-to-end tests over the
 //! bus and `tsukami demo`, so "what the paper says" is written once.
 
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
+use tsukami_grasp::contact::Contact;
+use tsukami_grasp::exact::{exact_test, ConeModel};
+use tsukami_grasp::grasp::Grasp;
 use tsukami_msgs::planner::{GraspStyle, PlanReply};
 
 /// What the paper reports for one scene.
@@ -108,6 +111,28 @@ pub fn paper_scene(name: &str) -> Option<&'static PaperScene> {
 pub fn approach_direction(reply: &PlanReply) -> Vector3<f64> {
     let [x, y, z, w] = reply.palm_pose.quaternion;
     UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z)) * Vector3::z()
+}
+
+/// The largest multiple of the object's weight the reply's contacts can hold, from the
+/// reply alone: its contacts, `f_max`, `mu`, characteristic length and centre of mass,
+/// under exact (circular) friction cones (`tsukami-grasp`'s conic program). This does
+/// not trust the planner's own `exact_resists_weight` flag; ≥ 1 means the grasp holds.
+pub fn exact_weight_scale(reply: &PlanReply) -> Result<f64, String> {
+    let contacts = reply
+        .contacts
+        .iter()
+        .map(|c| Contact::new(Point3::from(c.position), Vector3::from(c.normal)))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| format!("reply contact: {e}"))?;
+    let limits = reply.contacts.iter().map(|c| c.f_max).collect();
+    let com = Point3::from(reply.object.center_of_mass);
+    let grasp =
+        Grasp::with_force_limits(contacts, limits, reply.mu, reply.characteristic_length, com)
+            .map_err(|e| format!("reply grasp: {e}"))?;
+    let weight = grasp.weight_wrench(reply.object.mass, &Vector3::new(0.0, 0.0, -9.81), &com);
+    let test =
+        exact_test(&grasp, ConeModel::Circular, &weight).map_err(|e| format!("exact test: {e}"))?;
+    Ok(test.weight.weight_scale)
 }
 
 impl PaperScene {

@@ -4,11 +4,8 @@
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::Vector3;
 use tsukami_antipodal_planner::AntipodalPlanner;
-use tsukami_grasp::contact::Contact;
-use tsukami_grasp::exact::{exact_test, ConeModel};
-use tsukami_grasp::grasp::Grasp;
 use tsukami_msgs::planner::{PlanOptions, PlanReply};
 
 fn models() -> PathBuf {
@@ -26,19 +23,7 @@ fn planner_for(scene: &str) -> AntipodalPlanner {
 
 /// Rebuilds the grasp from the reply alone and runs the exact test.
 fn independent_exact_check(r: &PlanReply) -> bool {
-    let contacts: Vec<Contact> = r
-        .contacts
-        .iter()
-        .map(|c| Contact::new(Point3::from(c.position), Vector3::from(c.normal)).unwrap())
-        .collect();
-    let limits = r.contacts.iter().map(|c| c.f_max).collect();
-    let com = Point3::from(r.object.center_of_mass);
-    let grasp =
-        Grasp::with_force_limits(contacts, limits, r.mu, r.characteristic_length, com).unwrap();
-    let weight = grasp.weight_wrench(r.object.mass, &Vector3::new(0.0, 0.0, -9.81), &com);
-    exact_test(&grasp, ConeModel::Circular, &weight)
-        .unwrap()
-        .resists_weight()
+    tsukami_scenes::paper::exact_weight_scale(r).unwrap() >= 1.0
 }
 
 fn check_scene(scene: &str) {
