@@ -1,0 +1,66 @@
+use std::path::PathBuf;
+use std::time::Instant;
+use tsukami_body::files::ModelRoots;
+use tsukami_vision::detect::{DetectParams, Detector, Outcome};
+use tsukami_vision::sim::testbed::Testbed;
+fn main() {
+    tracing_subscriber::fmt()
+        .with_max_level(tracing::Level::DEBUG)
+        .with_writer(std::io::stderr)
+        .init();
+    let a: Vec<String> = std::env::args().collect();
+    let target = a.get(1).cloned().unwrap_or("can_350ml".into());
+    let asked = a.get(2).cloned().unwrap_or(target.clone());
+    let occ = a.get(3).filter(|s| *s != "-").cloned();
+    let seed: u64 = a.get(4).and_then(|s| s.parse().ok()).unwrap_or(0);
+    let models = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let mut tb = Testbed::new(
+        &models.join("scenes/can_waist.toml"),
+        "table",
+        &models.join("objects"),
+    )
+    .unwrap();
+    let mut det = Detector::new(ModelRoots::new([models.clone()]), DetectParams::default());
+    let sym = det.template(&target).unwrap().symmetry.clone();
+    println!(
+        "symmetry of {target}: axis {:?} discrete {}",
+        sym.axis,
+        sym.discrete.len()
+    );
+    let t = tb.trial(&target, occ.as_deref(), 0.3, seed).unwrap();
+    println!(
+        "truth {:?} occl {:.2} valid px {}",
+        t.truth,
+        t.occluded,
+        t.image.valid_count()
+    );
+    for _ in 0..2 {
+        let s = Instant::now();
+        let out = det.detect(&asked, &t.image, &t.camera).unwrap();
+        println!("{:.1} ms", s.elapsed().as_secs_f64() * 1e3);
+        match out {
+            Outcome::Found(d) => {
+                let (dp, da) = sym.pose_error(&d.pose, &t.truth);
+                println!(
+                    "FOUND pose {:?}\n err {:.2} mm {:.2} deg rms {:.4} conf {:.3} {:?}",
+                    d.pose,
+                    dp * 1e3,
+                    da.to_degrees(),
+                    d.rms,
+                    d.confidence,
+                    d.verdict
+                );
+            }
+            Outcome::NotFound(n) => println!(
+                "NOT FOUND: {} best {:?}",
+                n.reason,
+                n.best.map(|b| (b.pose, b.verdict))
+            ),
+        }
+    }
+    if a.iter().any(|x| x == "--save") {
+        t.image
+            .save(std::path::Path::new("/tmp/vis_debug.png"))
+            .unwrap();
+    }
+}

@@ -1,0 +1,41 @@
+//! # tsukami-vision
+//!
+//! The vision component of Tsukami: the pose of a known object from a depth
+//! image, and a depth-camera simulator for the robot's head camera.
+//!
+//! Pipeline ([`detect`]): back-project the depth image ([`cloud`]), remove the
+//! supporting planes by RANSAC ([`plane`]), cluster what is left
+//! ([`cluster`]), guess poses from each cluster's principal axes and the
+//! model's ([`hypotheses`]), refine them by point-to-plane ICP against the
+//! model's surface ([`icp`], [`template`]), and judge the result against the
+//! image ([`verify`]): a pose is reported only when the model explains the
+//! measured points and the image does not see through where the model would
+//! be. Symmetric objects are reported modulo their symmetry ([`symmetry`]).
+//!
+//! The simulator ([`sim`]) renders a scene file by ray casting its meshes and
+//! primitives with parry3d, seen from the head camera of the robot model, with
+//! the noise model documented in [`sim::noise`].
+//!
+//! The bus side ([`service`]) answers `<ns>/vision/detect` and publishes
+//! `<ns>/vision/pose/<object>`; the binary `tsukami-vision` runs it, and also
+//! renders and detects from files.
+
+pub mod camera;
+pub mod cli;
+pub mod cloud;
+pub mod cluster;
+pub mod depth;
+pub mod detect;
+pub mod error;
+pub mod hypotheses;
+pub mod icp;
+pub mod plane;
+pub mod sim;
+pub mod symmetry;
+pub mod template;
+pub mod verify;
+
+pub use camera::{Camera, Intrinsics};
+pub use depth::DepthImage;
+pub use detect::{Detection, Detector, Outcome};
+pub use error::{Result, VisionError};

@@ -1,0 +1,144 @@
+//! Judging a fitted pose against the image: is this the object, and is it there?
+//!
+//! What: [`verify`] scores a pose by two independent tests and combines them
+//! into a confidence in [0, 1].
+//!
+//! Why: ICP always returns *a* pose. A wrong model (a bottle fitted to a
+//! can) or a pose on clutter must be reported as not found, never as a
+//! confident pose; an occluded object must still be found.
+//!
+//! How:
+//! - *explained*: the fraction of the segment's measured points within
+//!   `inlier` of the model's surface. A wrong shape leaves many unexplained.
+//! - *free space*: the model's camera-facing surface samples are projected
+//!   into the image (a z-buffer keeps the nearest per pixel). Where the camera
+//!   measured a depth well *behind* the model's surface, it saw through where
+//!   the object would be: a violation. Much nearer measurements are occlusion
+//!   and count neither way; measurements within `support` of the model
+//!   support the pose; the rest (a surface a little in front of the model,
+//!   as when a smaller model is fitted inside a larger object) count against
+//!   it.
+//! - confidence = explained × supported / (supported + violations + near misses),
+//!   and 0 when less than `min_visible` of the model's unoccluded surface is
+//!   supported or more than `max_occluded` of it is hidden.
+
+use nalgebra::{Isometry3, Point3};
+
+use crate::camera::Camera;
+use crate::depth::DepthImage;
+use crate::template::ObjectTemplate;
+
+/// Verification settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VerifyParams {
+    /// A measured point within this distance of the surface is explained (m).
+    pub inlier: f64,
+    /// A measurement this close to the model's surface supports it (m).
+    pub support: f64,
+    /// A measurement this much behind the model's surface is a violation,
+    /// this much in front an occlusion (m).
+    pub free_space: f64,
+    /// Least supported fraction of the model's measured, unoccluded pixels.
+    pub min_visible: f64,
+    /// Largest hidden fraction of the model's measured pixels.
+    pub max_occluded: f64,
+}
+
+impl Default for VerifyParams {
+    fn default() -> Self {
+        VerifyParams {
+            inlier: 0.005,
+            support: 0.008,
+            free_space: 0.015,
+            min_visible: 0.5,
+            max_occluded: 0.6,
+        }
+    }
+}
+
+/// The outcome of verification.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Verdict {
+    /// Fraction of the segment's points explained by the model.
+    pub explained: f64,
+    /// Model pixels whose measurement agrees with the model.
+    pub supported: usize,
+    /// Model pixels where the camera saw something nearer (occlusion).
+    pub occluded: usize,
+    /// Model pixels where the camera saw through the model.
+    pub violations: usize,
+    /// Model pixels with a surface a little in front of the model.
+    pub near_misses: usize,
+    /// Model pixels without a measurement.
+    pub unmeasured: usize,
+    /// The model rests on a plane found in the image (set by the detector).
+    pub resting: bool,
+    /// The combined confidence in [0, 1].
+    pub confidence: f64,
+}
+
+impl Verdict {
+    /// Fraction of the model's visible surface hidden by something in front.
+    pub fn occluded_fraction(&self) -> f64 {
+        let seen = self.supported + self.occluded + self.violations + self.near_misses;
+        self.occluded as f64 / seen.max(1) as f64
+    }
+}
+
+/// Scores `pose` of `template` against the `segment` points (base frame) it
+/// was fitted to and the image they came from.
+pub fn verify(
+    template: &ObjectTemplate,
+    pose: &Isometry3<f64>,
+    segment: &[Point3<f64>],
+    image: &DepthImage,
+    camera: &Camera,
+    params: &VerifyParams,
+) -> Verdict {
+    let inv = pose.inverse();
+    let gate2 = params.inlier * params.inlier;
+    let explained = segment
+        .iter()
+        .filter(|p| template.nearest(&(inv * *p)).1 <= gate2)
+        .count() as f64
+        / segment.len().max(1) as f64;
+
+    // Z-buffer of the camera-facing samples.
+    let cam_obj = inv * camera.centre();
+    let to_cam = camera.pose.inverse() * pose;
+    let mut splats: Vec<(u32, f64)> = Vec::new();
+    for (p, n) in template.points.iter().zip(&template.normals) {
+        if n.dot(&(cam_obj - p)) <= 0.0 {
+            continue;
+        }
+        let pc = to_cam * p;
+        if let Some((u, v)) = camera.intrinsics.pixel_of(&pc) {
+            splats.push((v * camera.intrinsics.width + u, pc.z));
+        }
+    }
+    splats.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    splats.dedup_by_key(|s| s.0);
+    let mut verdict = Verdict {
+        explained,
+        ..Verdict::default()
+    };
+    let width = camera.intrinsics.width;
+    for (pixel, z) in splats {
+        match image.get(pixel % width, pixel / width) {
+            None => verdict.unmeasured += 1,
+            Some(d) if d > z + params.free_space => verdict.violations += 1,
+            Some(d) if d < z - params.free_space => verdict.occluded += 1,
+            Some(d) if (d - z).abs() <= params.support => verdict.supported += 1,
+            Some(_) => verdict.near_misses += 1,
+        }
+    }
+    let judged = (verdict.supported + verdict.violations + verdict.near_misses).max(1) as f64;
+    let supported = verdict.supported as f64 / judged;
+    verdict.confidence =
+        if supported >= params.min_visible && verdict.occluded_fraction() <= params.max_occluded {
+            explained * supported
+        } else {
+            0.0
+        };
+    verdict
+}
