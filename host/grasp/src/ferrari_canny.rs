@@ -1,6 +1,6 @@
 //! Ferrari–Canny grasp quality ε for the L1 and L∞ grasp wrench spaces,
 //! eqs. (7)–(8), with `k`-sided polyhedral friction cones and 6-D convex
-//! hulls (Qhull, through the `qhull` crate).
+//! hulls ([`crate::hull`]: the vendored Qhull, built with a C compiler only).
 //!
 //! Each friction cone is replaced by the pyramid inscribed in it with `k`
 //! edges `d_ij = f_max,i (n_i + μ (cos θ_j t1 + sin θ_j t2))`, `θ_j = 2πj/k`:
@@ -31,11 +31,11 @@
 //! run for minutes. Measured figures are in `docs/force-closure.md`.
 
 use nalgebra::Vector6;
-use qhull::Qh;
 
 use crate::exact::grasp_rank;
 use crate::grasp::Grasp;
 use crate::grasp_matrix::{contact_block, Wrench};
+use crate::hull::{hull, Hull};
 
 /// `|ε|` below this fraction of the largest wrench's norm is reported as 0:
 /// the origin is on the hull's boundary (common with flat faces: contacts on
@@ -108,19 +108,16 @@ pub fn primitive_wrenches(grasp: &Grasp, sides: usize) -> Result<Vec<Wrench>, Fe
 }
 
 /// Smallest facet distance of the hull of `points` from the origin, or `None`
-/// if Qhull cannot build a full-dimensional hull (flat or too few points).
+/// if no full-dimensional hull exists (flat or too few points).
 /// Negative when the origin is outside.
 fn hull_epsilon(points: &[Wrench]) -> Option<f64> {
-    build_hull(points).and_then(|qh| facet_epsilon(&qh, points))
+    build_hull(points, false).and_then(|h| facet_epsilon(&h, points))
 }
 
 /// Smallest facet distance from the origin of a built hull of `points`.
-fn facet_epsilon(qh: &Qh<'_>, points: &[Wrench]) -> Option<f64> {
-    let mut eps = f64::INFINITY;
-    for f in qh.facets() {
-        // Qhull: normal·x + offset ≤ 0 inside, unit outward normal.
-        eps = eps.min(-f.offset());
-    }
+fn facet_epsilon(h: &Hull, points: &[Wrench]) -> Option<f64> {
+    // Qhull: normal·x + offset ≤ 0 inside, unit outward normal.
+    let mut eps = h.facets.iter().map(|f| -f.offset).fold(f64::INFINITY, f64::min);
     // A facet through the origin comes out at ±1e-16 of it: rounding, not quality.
     let scale = points.iter().map(|p| p.norm()).fold(0.0, f64::max);
     if eps.abs() <= ZERO_TOLERANCE * scale {
@@ -129,13 +126,8 @@ fn facet_epsilon(qh: &Qh<'_>, points: &[Wrench]) -> Option<f64> {
     eps.is_finite().then_some(eps)
 }
 
-fn build_hull(points: &[Wrench]) -> Option<Qh<'static>> {
-    if points.len() < 7 {
-        return None;
-    }
-    Qh::builder()
-        .build_from_iter(points.iter().map(|p| [p[0], p[1], p[2], p[3], p[4], p[5]]))
-        .ok()
+fn build_hull(points: &[Wrench], with_vertices: bool) -> Option<Hull> {
+    hull(points, with_vertices).ok()
 }
 
 /// ε of the L1 grasp wrench space (eq. (8)).
@@ -153,7 +145,7 @@ pub fn epsilon_linf(
     let k = options.sides;
     let w = primitive_wrenches(grasp, k)?;
     if grasp_rank(grasp) < 6 {
-        // The whole sum is flat: no interior, and Qhull could not prune it.
+        // The whole sum is flat: no interior, and no hull could prune it.
         return Ok(0.0);
     }
     let mut set: Vec<Wrench> = vec![Vector6::zeros()];
@@ -171,18 +163,15 @@ pub fn epsilon_linf(
             next.push(*v);
             next.extend(chunk.iter().map(|e| v + e));
         }
-        let hull = build_hull(&next);
-        if i + 1 == contacts {
+        let last = i + 1 == contacts;
+        let built = build_hull(&next, !last);
+        if last {
             // ε from this hull itself: re-hulling its vertices can only lose precision.
-            let eps = hull.and_then(|qh| facet_epsilon(&qh, &next));
+            let eps = built.and_then(|h| facet_epsilon(&h, &next));
             return Ok(eps.unwrap_or(0.0).max(0.0));
         }
-        set = match hull {
-            Some(qh) => qh
-                .vertices()
-                .filter_map(|v| v.index(&qh))
-                .map(|i| next[i])
-                .collect(),
+        set = match built {
+            Some(h) => h.vertices.iter().filter_map(|&i| next.get(i)).copied().collect(),
             // Not yet full-dimensional: keep every candidate (still few).
             None => next,
         };

@@ -11,7 +11,7 @@
 //! | --- | --- | --- |
 //! | [`ellipsoid`] | the paper's eqs. (9)–(10), margin `n − f` | ~0.3 µs, no allocation |
 //! | [`exact`] | second-order cone programs (clarabel): exact closure, weight scale, forces | ~0.2 ms |
-//! | [`ferrari_canny`] | ε of the L1 and L∞ wrench spaces, 6-D hulls (Qhull) | ε_L1 ~3 ms, ε_L∞ seconds |
+//! | [`ferrari_canny`] | ε of the L1 and L∞ wrench spaces, 6-D hulls ([`hull`]: vendored Qhull) | ε_L1 ~3 ms, ε_L∞ seconds |
 //!
 //! Supporting modules: [`contact`] (contacts and contact frames `U_i`),
 //! [`grasp_matrix`] (eq. (6), `G` with torque scale `γ`), [`finger_force`]
@@ -51,4 +51,5 @@ pub mod ferrari_canny;
 pub mod finger_force;
 pub mod grasp;
 pub mod grasp_matrix;
+pub mod hull;
 pub mod problem;

@@ -50,18 +50,68 @@ fn reference_path() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/hull_reference.tsv")
 }
 
-/// Writes the reference file (run once with the old implementation).
+/// Parses the reference file into rows.
+fn reference() -> Vec<Row> {
+    let text = std::fs::read_to_string(reference_path()).expect("reference file");
+    text.lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| {
+            let f: Vec<&str> = l.split('\t').collect();
+            let linf = (f[4] != "-").then(|| f[4].parse().expect("eps_linf"));
+            (
+                f[0].parse().expect("shape"),
+                f[1].parse().expect("grasp"),
+                f[2].parse().expect("contacts"),
+                f[3].parse().expect("eps_l1"),
+                linf,
+            )
+        })
+        .collect()
+}
+
+/// Largest `|a − b| / max(1, |b|)` of the pairs, and the count of pairs on
+/// opposite sides of zero.
+fn compare(pairs: &[(f64, f64)]) -> (f64, usize) {
+    let worst = pairs
+        .iter()
+        .map(|(a, b)| (a - b).abs() / b.abs().max(1.0))
+        .fold(0.0, f64::max);
+    let flipped = pairs.iter().filter(|(a, b)| (*a > 0.0) != (*b > 0.0)).count();
+    (worst, flipped)
+}
+
+/// Tolerance on ε (N, relative above 1 N): ε values are 0.1–10 N here.
+const TOLERANCE: f64 = 1e-9;
+
 #[test]
-#[ignore = "records the reference file"]
-fn record_reference() {
-    use std::fmt::Write;
-    let mut out = String::from(
-        "# Ferrari-Canny reference: qhull crate 0.4.1 (Qhull 2020.2 via bindgen), 8-sided pyramids\n\
-         # shape(0 can, 1 box)\tgrasp\tcontacts\teps_l1\teps_linf\n",
-    );
-    for (s, i, n, l1, linf) in compute() {
-        let linf = linf.map_or("-".to_string(), |e| format!("{e:.16e}"));
-        writeln!(out, "{s}\t{i}\t{n}\t{l1:.16e}\t{linf}").unwrap();
+fn epsilon_matches_the_recorded_qhull_crate_values() {
+    let expected = reference();
+    let got = compute();
+    assert_eq!(got.len(), expected.len());
+    let mut l1 = Vec::new();
+    let mut linf = Vec::new();
+    for (g, e) in got.iter().zip(&expected) {
+        assert_eq!((g.0, g.1, g.2), (e.0, e.1, e.2), "same grasp sequence");
+        l1.push((g.3, e.3));
+        if let (Some(a), Some(b)) = (g.4, e.4) {
+            linf.push((a, b));
+        }
     }
-    std::fs::write(reference_path(), out).unwrap();
+    assert_eq!(linf.len(), 2 * LINF_PER_SHAPE);
+    let (l1_worst, l1_flipped) = compare(&l1);
+    let (linf_worst, linf_flipped) = compare(&linf);
+    let positive = l1.iter().filter(|(_, b)| *b > 0.0).count();
+    println!(
+        "eps_L1: {} grasps ({positive} with eps > 0), largest difference {l1_worst:.3e}, {l1_flipped} closure verdicts differ",
+        l1.len()
+    );
+    println!(
+        "eps_Linf: {} grasps, largest difference {linf_worst:.3e}, {linf_flipped} closure verdicts differ",
+        linf.len()
+    );
+    // The set exercises both verdicts.
+    assert!(positive > 300 && positive < 700, "{positive}");
+    assert_eq!((l1_flipped, linf_flipped), (0, 0));
+    assert!(l1_worst <= TOLERANCE, "{l1_worst}");
+    assert!(linf_worst <= TOLERANCE, "{linf_worst}");
 }
