@@ -367,6 +367,46 @@ fn pair_collides(
     inside(&w1, p1, &w2, p2) || inside(&w2, p2, &w1, p1)
 }
 
+/// How deep one placed part sinks into another: 0 when they are apart or
+/// only touch; the overlap depth when they overlap; when `p1` lies inside
+/// the closed mesh `p2`, its distance to that surface plus its own size
+/// along the way out (a lower bound of the depth, never below the overlap).
+fn pair_depth(method: DistanceMethod, pose1: &Pose, p1: &Part, pose2: &Pose, p2: &Part) -> f64 {
+    if !aabbs_overlap(pose1, p1, pose2, p2, 0.0) {
+        return 0.0;
+    }
+    let w1 = *pose1 * p1.origin;
+    let w2 = *pose2 * p2.origin;
+    let inside = p2.solid_mesh
+        && p2
+            .shape
+            .contains_point(&w2, p1.shape.compute_aabb(&w1).center());
+    // Inside a closed mesh the surface may be far: look that far.
+    let reach = if inside {
+        let a = p2.shape.compute_aabb(&w2);
+        (a.maxs - a.mins).length()
+    } else {
+        0.0
+    };
+    match pair_proximity(method, pose1, p1, pose2, p2, reach) {
+        Some((d, ..)) if d < 0.0 => -d,
+        Some((d, ..)) if inside => d.max(0.0) + 1e-9,
+        _ => 0.0,
+    }
+}
+
+/// A link sunk into an object, found by [`RobotCollision::link_penetration`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Penetration {
+    /// The link.
+    pub link: LinkId,
+    /// Index of the object in the slice given to the query (0 for a single object).
+    pub object: usize,
+    /// Depth (m): how far the link is in, a lower bound when it lies wholly
+    /// inside a closed mesh.
+    pub depth: f64,
+}
+
 /// A colliding pair found by [`RobotCollision::first_collision`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Hit {
@@ -536,6 +576,50 @@ impl RobotCollision {
                             return Some(Hit { link, object: o });
                         }
                     }
+                }
+            }
+        }
+        None
+    }
+
+    /// How deep `link` sinks into `object` (0 when apart or only touching):
+    /// the deepest of its parts against the object's parts. Touching is
+    /// allowed; callers compare the depth with their tolerance.
+    pub fn link_penetration(&self, fk: &FkState, link: LinkId, object: &CollisionObject) -> f64 {
+        let link_pose = to_pose(fk.pose(link));
+        let mut depth: f64 = 0.0;
+        for lp in &self.parts[link] {
+            for op in &object.parts {
+                depth = depth.max(pair_depth(
+                    self.method,
+                    &link_pose,
+                    lp,
+                    &object.parry_pose,
+                    op,
+                ));
+            }
+        }
+        depth
+    }
+
+    /// The first of `links` that sinks deeper than `tolerance` into one of
+    /// `objects` (touching and shallower overlaps pass); `None` when none does.
+    pub fn first_penetration(
+        &self,
+        fk: &FkState,
+        links: &[LinkId],
+        objects: &[&CollisionObject],
+        tolerance: f64,
+    ) -> Option<Penetration> {
+        for &link in links {
+            for (o, object) in objects.iter().enumerate() {
+                let depth = self.link_penetration(fk, link, object);
+                if depth > tolerance {
+                    return Some(Penetration {
+                        link,
+                        object: o,
+                        depth,
+                    });
                 }
             }
         }
