@@ -88,6 +88,27 @@ pub enum BodyError {
         /// What is wrong.
         message: String,
     },
+    /// A `package://` URI names a package found in none of the places
+    /// searched.
+    #[error("{file}: {element}: package '{package}' not found; searched {}", searched_list(.searched))]
+    UnresolvedPackage {
+        /// The model file that references the mesh.
+        file: PathBuf,
+        /// The referencing element, e.g. `link 'base' visual 0`.
+        element: String,
+        /// The package name.
+        package: String,
+        /// Every folder searched, in order.
+        searched: Vec<PathBuf>,
+    },
+    /// A file or model exceeds a parse limit ([`crate::limits::ParseLimits`]).
+    #[error("{file}: too large: {message}")]
+    TooLarge {
+        /// The file.
+        file: PathBuf,
+        /// Which limit, and by how much.
+        message: String,
+    },
     /// A scene or object TOML file is malformed.
     #[error("{file}: {message}")]
     Toml {
@@ -106,6 +127,59 @@ pub enum BodyError {
     /// joint directly, a joint list with a fixed joint, a bad target).
     #[error("{0}")]
     Request(String),
+}
+
+fn searched_list(searched: &[PathBuf]) -> String {
+    if searched.is_empty() {
+        return "nothing (no package path is set: use ROS_PACKAGE_PATH, AMENT_PREFIX_PATH \
+                or --package-dir)"
+            .into();
+    }
+    let names: Vec<String> = searched.iter().map(|p| p.display().to_string()).collect();
+    names.join(", ")
+}
+
+/// What a [`LoadWarning`] is about, so callers can decide which ones they
+/// accept (a planner may refuse a robot whose collision geometry is
+/// incomplete).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WarningKind {
+    /// A quirk that reference parsers accept; the model is as they read it.
+    Quirk,
+    /// A visual element was skipped (no effect on kinematics or collision).
+    VisualSkipped,
+    /// A collision element was skipped: collision checks of that link are
+    /// incomplete.
+    CollisionSkipped,
+    /// A mesh was cleaned (duplicate vertices merged, degenerate or
+    /// non-finite triangles dropped).
+    MeshCleaned,
+}
+
+/// Something the lenient loader accepted that `--strict` refuses, or an
+/// element it skipped. Displays as `file: element: message`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LoadWarning {
+    /// The kind of warning.
+    pub kind: WarningKind,
+    /// The model or mesh file.
+    pub file: PathBuf,
+    /// The element, e.g. `joint 'r_elbow' limit`.
+    pub element: String,
+    /// What was wrong and what the loader did about it.
+    pub message: String,
+}
+
+impl std::fmt::Display for LoadWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}: {}: {}",
+            self.file.display(),
+            self.element,
+            self.message
+        )
+    }
 }
 
 /// Result alias of the body crate.

@@ -19,25 +19,31 @@
 //! # Ok::<(), tsukami_body::BodyError>(())
 //! ```
 //!
-//! Modules, lowest first: [`mesh`] (triangle meshes), [`model`] and [`urdf`]
-//! (the kinematic tree), [`kinematics`] (FK, Jacobians), [`ik`],
+//! Modules, lowest first: [`limits`] (parse limits, bounded reads),
+//! [`mesh`], [`mesh_clean`] and [`mesh_io`] (triangle meshes: STL, OBJ,
+//! Collada), [`packages`] (`package://` lookup), [`model`], [`urdf_xml`] and
+//! [`urdf`] (the kinematic tree, lenient or strict), [`kinematics`] (FK, Jacobians), [`ik`],
 //! [`collision`] (with its fast narrow phase [`capsule_mesh`]),
-//! [`shape_spec`], [`object`] and [`scene`] (TOML files), and
-//! [`report`] (what the `tsukami model` commands print).
+//! [`shape_spec`], [`object`] and [`scene`] (TOML files).
 
 pub mod capsule_mesh;
+pub mod collada;
 pub mod collision;
 pub mod convert;
 pub mod error;
 pub mod ik;
 pub mod kinematics;
+pub mod limits;
 pub mod mesh;
+pub mod mesh_clean;
+pub mod mesh_io;
 pub mod model;
 pub mod object;
-pub mod report;
+pub mod packages;
 pub mod scene;
 pub mod shape_spec;
 pub mod urdf;
+pub mod urdf_xml;
 
-pub use error::{BodyError, Result};
+pub use error::{BodyError, LoadWarning, Result, WarningKind};
 pub use model::{JointId, LinkId, RobotModel};

@@ -1,15 +1,16 @@
-//! Triangle meshes: loading (STL, OBJ), validation, watertightness, writing,
-//! and generators for closed meshes of revolution and boxes.
+//! Triangle meshes: the [`TriangleMesh`] type, validation, watertightness,
+//! volume and area, and generators for closed meshes of revolution and boxes.
 //!
 //! A [`TriangleMesh`] is plain data (vertices and index triples in the mesh's
 //! own frame) that callers such as the grasp planner can read directly, e.g.
-//! to fit the object's convex boxes (OCP). [`TriangleMesh::load`] validates
-//! what it reads and refuses meshes that would make distance queries
-//! meaningless: no triangles, non-finite vertices, indices out of range and
-//! zero-area triangles are errors naming the file. Whether a mesh is closed
-//! (every edge shared by exactly two triangles, consistently oriented) is
-//! reported by [`TriangleMesh::is_closed`], so callers can refuse open meshes
-//! where a solid is needed.
+//! to fit the object's convex boxes (OCP). Files are read and written in
+//! [`crate::mesh_io`] (STL, OBJ, Collada), and meshes as they come are
+//! cleaned in [`crate::mesh_clean`]: duplicate vertices merged, zero-area,
+//! non-finite and badly indexed triangles dropped and counted. Open and
+//! non-manifold meshes load; whether a mesh is closed (every edge shared by
+//! exactly two triangles, consistently oriented) is reported by
+//! [`TriangleMesh::is_closed`], so callers can choose a fallback where a
+//! solid is needed.
 //!
 //! ```
 //! use tsukami_body::mesh::TriangleMesh;
@@ -18,13 +19,8 @@
 //! assert!((can.volume() - std::f64::consts::PI * 0.033f64.powi(2) * 0.122).abs() < 2e-5);
 //! ```
 
-use std::collections::HashMap;
-use std::io::Write;
-use std::path::Path;
-
 use nalgebra::{Point3, Vector3};
-
-use crate::error::{BodyError, Result};
+use std::collections::HashMap;
 
 /// A triangle mesh in its own frame: vertices and counter-clockwise
 /// (outward-facing, seen from outside) index triples.
@@ -37,108 +33,6 @@ pub struct TriangleMesh {
 }
 
 impl TriangleMesh {
-    /// Loads an STL (binary or ASCII) or OBJ file, scales every vertex by
-    /// `scale` component-wise, and validates the result (see
-    /// [`TriangleMesh::validate`]). The format is chosen by the extension.
-    pub fn load(path: &Path, scale: Vector3<f64>) -> Result<Self> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(|e| e.to_ascii_lowercase())
-            .unwrap_or_default();
-        let mut mesh = match ext.as_str() {
-            "stl" => Self::read_stl(path)?,
-            "obj" => Self::read_obj(path)?,
-            _ => {
-                return Err(BodyError::Mesh {
-                    file: path.to_path_buf(),
-                    message: format!("unsupported mesh format '.{ext}' (use .stl or .obj)"),
-                })
-            }
-        };
-        if !scale.iter().all(|s| s.is_finite() && *s != 0.0) {
-            return Err(BodyError::Mesh {
-                file: path.to_path_buf(),
-                message: format!("scale {:?} must be finite and non-zero", scale.as_slice()),
-            });
-        }
-        for v in &mut mesh.vertices {
-            v.coords.component_mul_assign(&scale);
-        }
-        // A negative scale determinant mirrors the mesh: flip the winding so
-        // the normals stay outward.
-        if scale.x * scale.y * scale.z < 0.0 {
-            for t in &mut mesh.indices {
-                t.swap(1, 2);
-            }
-        }
-        mesh.validate().map_err(|message| BodyError::Mesh {
-            file: path.to_path_buf(),
-            message,
-        })?;
-        Ok(mesh)
-    }
-
-    fn read_stl(path: &Path) -> Result<Self> {
-        let mut file = std::fs::File::open(path).map_err(|source| BodyError::Io {
-            file: path.to_path_buf(),
-            source,
-        })?;
-        let stl = stl_io::read_stl(&mut file).map_err(|e| BodyError::Mesh {
-            file: path.to_path_buf(),
-            message: format!("cannot parse STL: {e}"),
-        })?;
-        let vertices = stl
-            .vertices
-            .iter()
-            .map(|v| Point3::new(v[0] as f64, v[1] as f64, v[2] as f64))
-            .collect();
-        let indices = stl
-            .faces
-            .iter()
-            .map(|f| {
-                [
-                    f.vertices[0] as u32,
-                    f.vertices[1] as u32,
-                    f.vertices[2] as u32,
-                ]
-            })
-            .collect();
-        Ok(Self { vertices, indices })
-    }
-
-    fn read_obj(path: &Path) -> Result<Self> {
-        let options = tobj::LoadOptions {
-            triangulate: true,
-            single_index: false,
-            ignore_points: true,
-            ignore_lines: true,
-        };
-        let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| BodyError::Mesh {
-            file: path.to_path_buf(),
-            message: format!("cannot parse OBJ: {e}"),
-        })?;
-        let mut mesh = TriangleMesh {
-            vertices: Vec::new(),
-            indices: Vec::new(),
-        };
-        for model in models {
-            let m = model.mesh;
-            let base = mesh.vertices.len() as u32;
-            mesh.vertices.extend(
-                m.positions
-                    .chunks_exact(3)
-                    .map(|p| Point3::new(p[0] as f64, p[1] as f64, p[2] as f64)),
-            );
-            mesh.indices.extend(
-                m.indices
-                    .chunks_exact(3)
-                    .map(|t| [base + t[0], base + t[1], base + t[2]]),
-            );
-        }
-        Ok(mesh)
-    }
-
     /// Checks that the mesh has triangles, finite vertices, indices in range
     /// and no zero-area triangle. Returns a message describing the first
     /// problem found.
@@ -268,45 +162,6 @@ impl TriangleMesh {
     pub fn triangle_normal(&self, k: usize) -> Vector3<f64> {
         let [a, b, c] = self.triangle(k);
         (b - a).cross(&(c - a)).normalize()
-    }
-
-    /// Writes a binary STL file.
-    pub fn write_stl(&self, path: &Path) -> Result<()> {
-        let io_err = |source| BodyError::Io {
-            file: path.to_path_buf(),
-            source,
-        };
-        let triangles: Vec<stl_io::Triangle> = (0..self.indices.len())
-            .map(|k| {
-                let n = self.triangle_normal(k);
-                let v = self.triangle(k);
-                let f = |p: &Point3<f64>| stl_io::Vertex::new([p.x as f32, p.y as f32, p.z as f32]);
-                stl_io::Triangle {
-                    normal: stl_io::Normal::new([n.x as f32, n.y as f32, n.z as f32]),
-                    vertices: [f(&v[0]), f(&v[1]), f(&v[2])],
-                }
-            })
-            .collect();
-        let mut file = std::fs::File::create(path).map_err(io_err)?;
-        stl_io::write_stl(&mut file, triangles.iter()).map_err(io_err)?;
-        Ok(())
-    }
-
-    /// Writes a Wavefront OBJ file (positions and faces only).
-    pub fn write_obj(&self, path: &Path) -> Result<()> {
-        let io_err = |source| BodyError::Io {
-            file: path.to_path_buf(),
-            source,
-        };
-        let mut out = std::io::BufWriter::new(std::fs::File::create(path).map_err(io_err)?);
-        writeln!(out, "# generated by tsukami-body").map_err(io_err)?;
-        for v in &self.vertices {
-            writeln!(out, "v {:.6} {:.6} {:.6}", v.x, v.y, v.z).map_err(io_err)?;
-        }
-        for t in &self.indices {
-            writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1).map_err(io_err)?;
-        }
-        out.flush().map_err(io_err)
     }
 
     /// A closed solid of revolution about the z axis. `profile` lists
@@ -444,34 +299,5 @@ mod tests {
         let mut range = TriangleMesh::cuboid(Vector3::new(1.0, 1.0, 1.0));
         range.indices[2] = [0, 1, 99];
         assert!(range.validate().unwrap_err().contains("triangle 2"));
-    }
-
-    #[test]
-    fn stl_and_obj_round_trip_with_scale() {
-        let dir = std::env::temp_dir().join(format!("tsukami-body-mesh-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let c = TriangleMesh::cylinder(0.03, 0.1, 12);
-        for name in ["c.stl", "c.obj"] {
-            let p = dir.join(name);
-            if name.ends_with("stl") {
-                c.write_stl(&p).unwrap();
-            } else {
-                c.write_obj(&p).unwrap();
-            }
-            let back = TriangleMesh::load(&p, Vector3::new(2.0, 2.0, 2.0)).unwrap();
-            assert_eq!(back.indices.len(), c.indices.len());
-            assert!(back.is_closed(), "{name}");
-            assert!((back.volume() - 8.0 * c.volume()).abs() < 1e-6, "{name}");
-            // Mirroring keeps the normals outward.
-            let m = TriangleMesh::load(&p, Vector3::new(-1.0, 1.0, 1.0)).unwrap();
-            assert!(m.volume() > 0.0, "{name}");
-        }
-        let bad = dir.join("bad.stl");
-        std::fs::write(&bad, b"solid x\nendsolid x\n").unwrap();
-        let err = TriangleMesh::load(&bad, Vector3::repeat(1.0))
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("bad.stl"), "{err}");
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

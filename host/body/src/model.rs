@@ -1,8 +1,8 @@
 //! The robot model: links and joints in topological order, their limits,
 //! mimic couplings, inertials and geometry.
 //!
-//! A [`RobotModel`] is built by [`crate::urdf::load_urdf`] (or
-//! [`RobotModel::from_urdf_str`]). Its links are stored root first in
+//! A [`RobotModel`] is built by `crate::urdf` (`load_urdf`, or
+//! `RobotModel::from_urdf_str`, defined there). Its links are stored root first in
 //! depth-first order, and joint `j` is always the parent joint of link `j + 1`,
 //! so forward kinematics is one pass over an array ([`crate::kinematics`]).
 //! Joint positions are a plain `&[f64]` with one entry per joint (fixed joints
@@ -10,7 +10,7 @@
 //! recomputed from their masters.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use nalgebra::{Isometry3, Matrix3, Unit, Vector3};
@@ -242,11 +242,6 @@ impl RobotModel {
             link_index,
             joint_index,
         }
-    }
-
-    /// Parses a URDF string; relative mesh paths resolve against `base_dir`.
-    pub fn from_urdf_str(xml: &str, base_dir: &Path) -> Result<Self> {
-        crate::urdf::parse_urdf(xml, &base_dir.join("<string>"))
     }
 
     /// Number of joints (the length of a joint-position vector).

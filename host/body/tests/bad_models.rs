@@ -1,8 +1,9 @@
 //! Bad models give errors that name the file and the element; nothing panics.
+//! Quirks that reference parsers accept are errors only with `strict`.
 
 use std::path::{Path, PathBuf};
 
-use tsukami_body::urdf::load_urdf;
+use tsukami_body::urdf::{load_urdf, load_urdf_with, LoadOptions};
 use tsukami_body::BodyError;
 
 struct Dir(PathBuf);
@@ -45,6 +46,29 @@ fn load_err(dir: &Dir, file: &str, text: &str) -> (BodyError, String) {
     (e, msg)
 }
 
+/// Fails only in strict mode; the lenient default loads it with a warning
+/// that names the file.
+fn strict_err(dir: &Dir, file: &str, text: &str) -> (BodyError, String) {
+    let p = dir.write(file, text);
+    let lenient = load_urdf_with(&p, &LoadOptions::default()).expect("lenient loads");
+    assert!(
+        lenient
+            .warnings
+            .iter()
+            .any(|w| w.to_string().contains(file)),
+        "{:?}",
+        lenient.warnings
+    );
+    let strict = LoadOptions {
+        strict: true,
+        ..LoadOptions::default()
+    };
+    let e = load_urdf_with(&p, &strict).expect_err("strict must fail");
+    let msg = e.to_string();
+    assert!(msg.contains(file), "message does not name the file: {msg}");
+    (e, msg)
+}
+
 #[test]
 fn malformed_xml() {
     let d = Dir::new("xml");
@@ -77,7 +101,7 @@ fn mesh_without_triangles() {
     let d = Dir::new("empty");
     d.write("empty.stl", "solid empty\nendsolid empty\n");
     let text = robot(
-        r#"<link name="a"><visual><geometry><mesh filename="empty.stl"/></geometry></visual></link>"#,
+        r#"<link name="a"><collision><geometry><mesh filename="empty.stl"/></geometry></collision></link>"#,
     );
     let p = d.write("e.urdf", &text);
     let e = load_urdf(&p).unwrap_err();
@@ -94,7 +118,7 @@ fn mesh_without_triangles() {
     d.write("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
     for f in ["zero.stl", "points.obj"] {
         let text = robot(&format!(
-            r#"<link name="a"><visual><geometry><mesh filename="{f}"/></geometry></visual></link>"#
+            r#"<link name="a"><collision><geometry><mesh filename="{f}"/></geometry></collision></link>"#
         ));
         let p = d.write("z.urdf", &text);
         let msg = load_urdf(&p).unwrap_err().to_string();
@@ -160,7 +184,7 @@ fn loops() {
         <joint name="j2" type="revolute"><parent link="b"/><child link="c"/><axis xyz="0 0 1"/>
           <limit lower="-1" upper="1" effort="1" velocity="1"/><mimic joint="j1"/></joint>"#
     ));
-    let (e, _) = load_err(&d, "mimic.urdf", &text);
+    let (e, _) = strict_err(&d, "mimic.urdf", &text);
     assert!(matches!(e, BodyError::Mimic { .. }), "{e:?}");
 }
 
@@ -193,8 +217,8 @@ fn other_invalid_values() {
     let text = robot(
         r#"<link name="a"><collision><geometry><box size="0.1 -1 0.1"/></geometry></collision></link>"#,
     );
-    let (_, msg) = load_err(&d, "box.urdf", &text);
-    assert!(msg.contains("box size"), "{msg}");
+    let (_, msg) = strict_err(&d, "box.urdf", &text);
+    assert!(msg.contains("box: size -1"), "{msg}");
     let text = robot(&format!(
         "{TWO_LINKS}{}",
         joint("j", "a", "b", "").replace("0 0 1", "0 0 0")
