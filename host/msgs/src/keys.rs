@@ -116,6 +116,21 @@ impl KeySpace {
         self.key("controller/state")
     }
 
+    /// `<ns>/controller/stop`: cancel the trajectory the controller is executing.
+    pub fn controller_stop(&self) -> String {
+        self.key(&format!("controller/{STOP}"))
+    }
+
+    /// `<ns>/<component>/info`: a component's name, version and keys.
+    pub fn component_info(&self, component: &str) -> String {
+        self.key(&format!("{component}/info"))
+    }
+
+    /// `<ns>/*/info`: every component's info (query it to see what is on the bus).
+    pub fn component_info_all(&self) -> String {
+        self.key("*/info")
+    }
+
     /// Splits a key under a role's prefix into its command: `tsukami/planner/plan` → `plan`.
     pub fn command_of<'k>(&self, role: &str, key: &'k str) -> Option<&'k str> {
         let prefix = self.key(&format!("{}/", role_prefix(role)));
@@ -141,6 +156,9 @@ mod tests {
         );
         assert_eq!(ks.host_plugins(), "tsukami/host/plugins");
         assert_eq!(ks.vision_pose("can"), "tsukami/vision/pose/can");
+        assert_eq!(ks.controller_stop(), "tsukami/controller/stop");
+        assert_eq!(ks.component_info("vision"), "tsukami/vision/info");
+        assert_eq!(ks.component_info_all(), "tsukami/*/info");
         assert_eq!(
             KeySpace::new("robot2/").role_wildcard("grasp-planner"),
             "robot2/planner/**"

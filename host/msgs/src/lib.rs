@@ -10,11 +10,13 @@
 //! - [`error`]: the common error object.
 //! - [`common`]: poses and joint maps used by several messages.
 //! - [`planner`], [`motion`], [`controller`], [`vision`], [`host`]: one module per
-//!   component of the key table in `docs/protocol.md`.
+//!   component of the key table in `docs/protocol.md`; [`component`]: what every
+//!   component process answers about itself.
 //! - [`schema`]: the JSON Schema of every payload, written to `docs/schema/` by
 //!   `tsukami schema --out docs/schema`.
 
 pub mod common;
+pub mod component;
 pub mod controller;
 pub mod error;
 pub mod host;

@@ -21,7 +21,11 @@ fn default_lift() -> f64 {
     0.05
 }
 
-/// A joint trajectory: named joints, timed waypoints.
+/// A joint trajectory: named joints, timed waypoints. The trajectory planner makes
+/// them and `<ns>/controller/execute` runs them.
+///
+/// Between two waypoints the controller interpolates linearly in joint space, or by
+/// cubic Hermite segments when every waypoint gives `velocities`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct JointTrajectory {
@@ -35,10 +39,17 @@ pub struct JointTrajectory {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TrajectoryPoint {
-    /// Time from the trajectory's start, seconds.
+    /// Time from the trajectory's start, seconds (also accepted as `time_from_start`).
+    #[serde(alias = "time_from_start")]
     pub time: f64,
     /// Joint positions in `joint_names` order.
     pub positions: Vec<f64>,
-    /// Which phase this point belongs to: `approach`, `grasp`, `close` or `lift`.
+    /// Joint velocities in `joint_names` order; empty for none (then the controller
+    /// interpolates linearly between positions).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub velocities: Vec<f64>,
+    /// Which phase this point belongs to: `approach`, `grasp`, `close` or `lift`
+    /// (empty when the maker has no phases).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
     pub phase: String,
 }

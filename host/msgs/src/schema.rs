@@ -32,6 +32,7 @@ pub fn all() -> Vec<NamedSchema> {
         named::<crate::controller::ExecuteRequest>("controller_execute_request"),
         named::<crate::controller::ExecuteReply>("controller_execute_reply"),
         named::<crate::controller::ControllerState>("controller_state"),
+        named::<crate::component::ComponentInfo>("component_info"),
         named::<crate::vision::DetectRequest>("vision_detect_request"),
         named::<crate::vision::ObjectPose>("vision_object_pose"),
         named::<crate::planner::SetRobot>("planner_set_robot_request"),
