@@ -16,12 +16,12 @@
 //! Supporting modules: [`contact`] (contacts and contact frames `U_i`),
 //! [`grasp_matrix`] (eq. (6), `G` with torque scale `γ`), [`finger_force`]
 //! (per-contact force limits from a finger Jacobian and joint efforts) and
-//! [`problem`], the JSON contract of the `tsukami fc` command
-//! ([`problem::solve_json`]).
+//! [`hull`] (6-D convex hulls). Pure functions only: the JSON contract of the
+//! `tsukami fc` command lives in the CLI (`host/app/src/cli/fc_problem.rs`).
 //!
 //! Conventions: world frame, metres, newtons. Contact normals point **into**
 //! the object. Wrenches are `[f; γ τ]` with torques about a reference point —
-//! the centre of mass in [`problem`] — and `γ = 1 / characteristic_length`.
+//! the centre of mass in `tsukami fc` — and `γ = 1 / characteristic_length`.
 //!
 //! ```
 //! use nalgebra::{Point3, Vector3};
@@ -52,4 +52,3 @@ pub mod finger_force;
 pub mod grasp;
 pub mod grasp_matrix;
 pub mod hull;
-pub mod problem;

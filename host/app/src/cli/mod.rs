@@ -2,7 +2,10 @@
 //! offline tools.
 
 mod fc;
+mod fc_problem;
+mod fc_solve;
 mod model;
+mod model_report;
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};

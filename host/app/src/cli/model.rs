@@ -1,14 +1,14 @@
 //! `tsukami model inspect|fk|ik`: the body library on the command line.
 //!
-//! Output field names are a contract external tools rely on (see `host/body`'s
-//! `report` module, which defines them); `--batch FILE` runs thousands of
+//! Output field names are a contract external tools rely on (see
+//! [`super::model_report`], which defines them); `--batch FILE` runs thousands of
 //! configurations in one process.
 
 use anyhow::{Context, Result};
 use clap::Subcommand;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use tsukami_body::report::{self, IkRequest};
+use super::model_report::{self as report, IkRequest};
 
 /// Subcommands of `tsukami model`.
 #[derive(Subcommand, Debug)]
