@@ -24,7 +24,7 @@ use tsukami_body::files::ModelRoots;
 
 use crate::camera::Camera;
 use crate::cloud::{Moments, PointCloud};
-use crate::cluster::clusters;
+use crate::cluster;
 use crate::depth::DepthImage;
 use crate::error::{invalid, Result};
 use crate::hypotheses::from_principal_axes;
@@ -91,7 +91,7 @@ impl Default for DetectParams {
                 ..IcpParams::default()
             },
             coarse_points: 250,
-            refine_top: 2,
+            refine_top: 3,
             fine: IcpParams {
                 iterations: 20,
                 gate_start: 0.02,
@@ -101,7 +101,7 @@ impl Default for DetectParams {
             fine_points: 1200,
             gather: 0.008,
             verify: VerifyParams::default(),
-            max_fine: 3,
+            max_fine: 4,
             early_accept: 0.9,
             require_support: true,
             max_penetration: 0.01,
@@ -224,62 +224,20 @@ pub fn detect_with(
         return not_found("the image has (almost) no depth measurements".into(), None);
     }
     let planes = find_planes(&cloud.points, &params.plane);
-    let segments = segment(&cloud, &planes, image.width(), params);
-    let t_segment = started.elapsed();
     let size_limit = template.radius * 1.25 + 0.01;
-    let cam = camera.centre();
-    // Coarse: every hypothesis on every object-sized cluster.
-    let mut coarse: Vec<(f64, usize, IcpFit)> = Vec::new();
-    for (si, seg) in segments.iter().enumerate().take(params.max_clusters) {
-        let Some(m) = Moments::of(seg) else { continue };
-        if seg.iter().any(|p| (p - m.centroid).norm() > size_limit) {
-            continue;
-        }
-        let pts = thin(seg, params.coarse_points);
-        let mut fits: Vec<(f64, usize, IcpFit)> = from_principal_axes(template, &m, &cam)
-            .into_iter()
-            .map(|h| {
-                let f = refine(template, &pts, Some(cam), h, &params.coarse);
-                (score(&f), si, f)
-            })
-            .collect();
-        fits.sort_by(|a, b| b.0.total_cmp(&a.0));
-        coarse.extend(fits.into_iter().take(params.refine_top));
-    }
-    let examined = coarse.len();
-    coarse.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let clusters = segment(&cloud, &planes, image.width(), params);
+    let segments = candidate_sets(&clusters, size_limit, params.max_clusters);
+    let t_segment = started.elapsed();
+    let coarse = coarse_fits(template, &segments, &camera.centre(), params);
     let t_coarse = started.elapsed();
-    // Fine: the best coarse fits, verified.
-    let mut best: Option<Candidate> = None;
-    for (_, si, c) in coarse.iter().take(params.max_fine) {
-        let cand = fine_fit(
-            template,
-            &segments[*si],
-            c.pose,
-            image,
-            camera,
-            &planes,
-            params,
-        );
-        if best
-            .as_ref()
-            .is_none_or(|b| cand.verdict.confidence > b.verdict.confidence)
-        {
-            best = Some(cand);
-        }
-        if best
-            .as_ref()
-            .is_some_and(|b| b.verdict.confidence >= params.early_accept)
-        {
-            break;
-        }
-    }
+    let best = best_fine(template, &segments, &coarse, image, camera, &planes, params);
     tracing::debug!(
         object = %template.name,
         points = cloud.len(),
         planes = planes.len(),
-        clusters = segments.len(),
-        hypotheses = examined,
+        clusters = clusters.len(),
+        candidates = segments.len(),
+        hypotheses = coarse.len(),
         segment_ms = t_segment.as_secs_f64() * 1e3,
         coarse_ms = (t_coarse - t_segment).as_secs_f64() * 1e3,
         fine_ms = (started.elapsed() - t_coarse).as_secs_f64() * 1e3,
@@ -289,7 +247,7 @@ pub fn detect_with(
         return not_found(
             format!(
                 "no object-sized cluster above the supporting plane ({} clusters, {} planes)",
-                segments.len(),
+                clusters.len(),
                 planes.len()
             ),
             None,
@@ -308,20 +266,89 @@ pub fn detect_with(
     if detection.confidence >= params.min_confidence {
         return Ok(Outcome::Found(detection));
     }
-    let v = &best.verdict;
-    let reason = format!(
+    let reason = explain(&best.verdict, params.min_confidence);
+    not_found(reason, Some(detection))
+}
+
+/// Why a candidate's confidence is too low, in words.
+fn explain(v: &Verdict, min_confidence: f64) -> String {
+    format!(
         "best candidate's confidence {:.2} is below {:.2}: the model explains {:.0} % of its cluster's points; \
          of the model's {} measured pixels {} agree, {} see through it, {} are hidden; resting on a plane: {}",
-        detection.confidence,
-        params.min_confidence,
+        v.confidence,
+        min_confidence,
         v.explained * 100.0,
         v.supported + v.violations + v.near_misses + v.occluded,
         v.supported,
         v.violations,
         v.occluded,
         if v.resting { "yes" } else { "no" },
-    );
-    not_found(reason, Some(detection))
+    )
+}
+
+/// Every principal-axis hypothesis on every cluster, after a short coarse
+/// ICP: the best `refine_top` of each cluster, best first, as (score,
+/// cluster index, fit).
+fn coarse_fits(
+    template: &ObjectTemplate,
+    segments: &[Vec<Point3<f64>>],
+    cam: &Point3<f64>,
+    params: &DetectParams,
+) -> Vec<(f64, usize, IcpFit)> {
+    let mut coarse: Vec<(f64, usize, IcpFit)> = Vec::new();
+    for (si, seg) in segments.iter().enumerate() {
+        let Some(m) = Moments::of(seg) else { continue };
+        let pts = thin(seg, params.coarse_points);
+        let mut fits: Vec<(f64, usize, IcpFit)> = from_principal_axes(template, &m, cam)
+            .into_iter()
+            .map(|h| {
+                let f = refine(template, &pts, Some(*cam), h, &params.coarse);
+                (score(&f), si, f)
+            })
+            .collect();
+        fits.sort_by(|a, b| b.0.total_cmp(&a.0));
+        coarse.extend(fits.into_iter().take(params.refine_top));
+    }
+    coarse.sort_by(|a, b| b.0.total_cmp(&a.0));
+    coarse
+}
+
+/// The verified fine fit of highest confidence among the best `max_fine`
+/// coarse fits (stopping early at `early_accept`).
+fn best_fine(
+    template: &ObjectTemplate,
+    segments: &[Vec<Point3<f64>>],
+    coarse: &[(f64, usize, IcpFit)],
+    image: &DepthImage,
+    camera: &Camera,
+    planes: &[FoundPlane],
+    params: &DetectParams,
+) -> Option<Candidate> {
+    let mut best: Option<Candidate> = None;
+    for (_, si, c) in coarse.iter().take(params.max_fine) {
+        let cand = fine_fit(
+            template,
+            &segments[*si],
+            c.pose,
+            image,
+            camera,
+            planes,
+            params,
+        );
+        if best
+            .as_ref()
+            .is_none_or(|b| cand.verdict.confidence > b.verdict.confidence)
+        {
+            best = Some(cand);
+        }
+        if best
+            .as_ref()
+            .is_some_and(|b| b.verdict.confidence >= params.early_accept)
+        {
+            break;
+        }
+    }
+    best
 }
 
 /// The off-plane points of the strided cloud, clustered; largest first.
@@ -352,9 +379,34 @@ fn segment(
             grid[v as usize * gw + u as usize] = Some(*p);
         }
     }
-    clusters(&grid, gw, params.cluster_gap, params.min_cluster_points)
+    cluster::clusters(&grid, gw, params.cluster_gap, params.min_cluster_points)
         .into_iter()
         .map(|c| c.into_iter().filter_map(|i| grid[i]).collect())
+        .collect()
+}
+
+/// Largest distance of a point from the centroid (infinite for < 3 points).
+fn extent(points: &[Point3<f64>]) -> f64 {
+    match Moments::of(points) {
+        Some(m) => points
+            .iter()
+            .map(|p| (p - m.centroid).norm())
+            .fold(0.0, f64::max),
+        None => f64::INFINITY,
+    }
+}
+
+/// The object-sized clusters among the largest `max`.
+fn candidate_sets(
+    segments: &[Vec<Point3<f64>>],
+    size_limit: f64,
+    max: usize,
+) -> Vec<Vec<Point3<f64>>> {
+    segments
+        .iter()
+        .take(max)
+        .filter(|s| extent(s) <= size_limit)
+        .cloned()
         .collect()
 }
 

@@ -18,7 +18,8 @@
 //!   support the pose; the rest (a surface a little in front of the model,
 //!   as when a smaller model is fitted inside a larger object) count against
 //!   it.
-//! - confidence = explained × supported / (supported + violations + near misses),
+//! - confidence = explained × supported / (supported + violations + near misses
+//!   + `unmeasured_weight` × unmeasured),
 //!   and 0 when less than `min_visible` of the model's unoccluded surface is
 //!   supported or more than `max_occluded` of it is hidden.
 
@@ -42,6 +43,10 @@ pub struct VerifyParams {
     pub min_visible: f64,
     /// Largest hidden fraction of the model's measured pixels.
     pub max_occluded: f64,
+    /// How much a model pixel without a measurement counts against the pose
+    /// (relative to a violation): no return can mean the camera saw through
+    /// the model to something out of range, or just a dropout.
+    pub unmeasured_weight: f64,
 }
 
 impl Default for VerifyParams {
@@ -52,6 +57,7 @@ impl Default for VerifyParams {
             free_space: 0.015,
             min_visible: 0.5,
             max_occluded: 0.6,
+            unmeasured_weight: 0.5,
         }
     }
 }
@@ -132,7 +138,11 @@ pub fn verify(
             Some(_) => verdict.near_misses += 1,
         }
     }
-    let judged = (verdict.supported + verdict.violations + verdict.near_misses).max(1) as f64;
+    let judged = (verdict.supported as f64
+        + verdict.violations as f64
+        + verdict.near_misses as f64
+        + verdict.unmeasured as f64 * params.unmeasured_weight)
+        .max(1.0);
     let supported = verdict.supported as f64 / judged;
     verdict.confidence =
         if supported >= params.min_visible && verdict.occluded_fraction() <= params.max_occluded {

@@ -7,6 +7,7 @@
 //! - [`render`]: ray casting the shapes (parry3d) into a depth image and a
 //!   label image.
 //! - [`noise`]: the documented noise model applied to the rendered depths.
+//! - [`scene_camera`]: the component's camera when none is attached.
 //! - [`testbed`]: objects at random resting poses on a table, with an
 //!   occluder placed to hide a given fraction of the target — what the
 //!   accuracy benchmark and the tests render.
@@ -14,5 +15,6 @@
 pub mod head;
 pub mod noise;
 pub mod render;
+pub mod scene_camera;
 pub mod testbed;
 pub mod world;

@@ -1,3 +1,13 @@
+//! One simulated trial, detected and explained: a debugging aid for the pipeline.
+//!
+//! `cargo run --release -p tsukami-vision --example trial -- TARGET [ASKED] [OCCLUDER|-] [SEED] [--save]`
+//!
+//! Renders TARGET at the random resting pose of SEED on the can_waist table (with
+//! OCCLUDER hiding 30 % of it), asks for ASKED (default TARGET), prints the outcome,
+//! the error against the truth and the stage timings (`RUST_LOG`-style debug logs on
+//! stderr). `--save` writes `/tmp/vis_overlay.png`: the depth image with the true
+//! (green) and detected (red) model surfaces drawn over it.
+
 use std::path::PathBuf;
 use std::time::Instant;
 use tsukami_body::files::ModelRoots;
@@ -40,6 +50,10 @@ fn main() {
         println!("{:.1} ms", s.elapsed().as_secs_f64() * 1e3);
         match out {
             Outcome::Found(d) => {
+                if a.iter().any(|x| x == "--save") {
+                    let tpl = det.template(&asked).unwrap();
+                    overlay(&t, &tpl.points, &d.pose);
+                }
                 let (dp, da) = sym.pose_error(&d.pose, &t.truth);
                 println!(
                     "FOUND pose {:?}\n err {:.2} mm {:.2} deg rms {:.4} conf {:.3} {:?}",
@@ -63,4 +77,35 @@ fn main() {
             .save(std::path::Path::new("/tmp/vis_debug.png"))
             .unwrap();
     }
+}
+
+fn overlay(
+    t: &tsukami_vision::sim::testbed::Trial,
+    pts: &[nalgebra::Point3<f64>],
+    pose: &nalgebra::Isometry3<f64>,
+) {
+    let (w, h) = (t.image.width(), t.image.height());
+    let mut rgb = vec![0u8; (w * h * 3) as usize];
+    for (i, d) in t.image.data().iter().enumerate() {
+        let g = if *d > 0.0 {
+            (255.0 * (1.0 - ((*d - 0.5) / 1.5).clamp(0.0, 1.0))) as u8
+        } else {
+            0
+        };
+        rgb[i * 3] = g;
+        rgb[i * 3 + 1] = g;
+        rgb[i * 3 + 2] = g;
+    }
+    for (pose, c) in [(t.truth, 1usize), (*pose, 0usize)] {
+        for p in pts.iter().step_by(3) {
+            if let Some((u, v)) = t.camera.pixel_of(&(pose * p)) {
+                rgb[((v * w + u) * 3) as usize + c] = 255;
+            }
+        }
+    }
+    let f = std::fs::File::create("/tmp/vis_overlay.png").unwrap();
+    let mut e = png::Encoder::new(f, w, h);
+    e.set_color(png::ColorType::Rgb);
+    e.set_depth(png::BitDepth::Eight);
+    e.write_header().unwrap().write_image_data(&rgb).unwrap();
 }

@@ -1,0 +1,143 @@
+//! The component as a separate process on a real zenoh bus (loopback): info,
+//! detect with its simulated camera, the published pose, set_object sent on to
+//! the world, error replies, and a clean exit on SIGTERM.
+
+use std::process::{Child, Command, Stdio};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use tsukami_bus::serve::reply_json;
+use tsukami_bus::{free_loopback_port, BusClient, BusConfig, RequestError};
+use tsukami_msgs::planner::SetObject;
+use tsukami_msgs::vision::ObjectPose;
+use tsukami_msgs::ErrorCode;
+use zenoh::Wait;
+
+struct Process(Child);
+
+impl Drop for Process {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+#[test]
+fn vision_component_over_the_bus() {
+    let port = free_loopback_port().unwrap();
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let ns = format!("test-vision-{}", std::process::id());
+    let mut child = Process(
+        Command::new(env!("CARGO_BIN_EXE_tsukami-vision"))
+            .args(["serve", "--listen", &endpoint, "--namespace", &ns])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    );
+    let client = BusClient::connect(&BusConfig::connecting(&endpoint), &ns).unwrap();
+    let info = client
+        .wait_for_component("vision", Duration::from_secs(60))
+        .unwrap();
+    assert_eq!(info.name, "vision");
+    assert!(
+        info.keys.contains(&format!("{ns}/vision/detect")),
+        "{:?}",
+        info.keys
+    );
+
+    // A mock world that records what it is sent.
+    let received: Arc<Mutex<Vec<SetObject>>> = Arc::default();
+    let sink = received.clone();
+    let _world = client
+        .session()
+        .declare_queryable(format!("{ns}/world/set_object"))
+        .callback(move |q| {
+            let bytes = q
+                .payload()
+                .map(|p| p.to_bytes().into_owned())
+                .unwrap_or_default();
+            if let Ok(set) = serde_json::from_slice::<SetObject>(&bytes) {
+                sink.lock().unwrap().push(set);
+            }
+            reply_json(&q, &serde_json::json!({}));
+        })
+        .wait()
+        .unwrap();
+    let poses = client
+        .session()
+        .declare_subscriber(format!("{ns}/vision/pose/can_350ml"))
+        .wait()
+        .unwrap();
+
+    // The can of models/scenes/can_waist.toml stands at (0.36, -0.25, 0.78).
+    let key = format!("{ns}/vision/detect");
+    let ask = |body: &str| client.request_key(&key, body.as_bytes(), Duration::from_secs(60));
+    let reply: ObjectPose = serde_json::from_slice(
+        &ask(r#"{"object": "can_350ml", "seed": 1, "set_object": true}"#).unwrap(),
+    )
+    .unwrap();
+    let p = reply.pose.position;
+    let err = ((p[0] - 0.36).powi(2) + (p[1] + 0.25).powi(2) + (p[2] - 0.78).powi(2)).sqrt();
+    assert!(err < 0.005, "pose {p:?} is {:.1} mm off", err * 1e3);
+    assert!(
+        reply.confidence >= 0.8 && reply.symmetry.is_some(),
+        "{reply:?}"
+    );
+    assert_eq!(
+        reply.sent_to.as_deref(),
+        Some(format!("{ns}/world/set_object").as_str())
+    );
+    let sent = received.lock().unwrap().clone();
+    assert_eq!(sent.len(), 1);
+    assert_eq!(sent[0].pose, reply.pose);
+    assert!((sent[0].mass - 0.15).abs() < 1e-12);
+    let published = poses
+        .recv_timeout(Duration::from_secs(10))
+        .unwrap()
+        .expect("a published pose");
+    let published: ObjectPose = serde_json::from_slice(&published.payload().to_bytes()).unwrap();
+    assert_eq!(published.pose, reply.pose);
+
+    // Same seed, same reply.
+    let again: ObjectPose =
+        serde_json::from_slice(&ask(r#"{"object": "can_350ml", "seed": 1}"#).unwrap()).unwrap();
+    assert_eq!(again.pose, reply.pose);
+
+    // Errors: an absent object, malformed JSON, an unknown field; still serving after.
+    let code = |r: Result<Vec<u8>, RequestError>| r.unwrap_err().code();
+    let absent = ask(r#"{"object": "box", "seed": 2}"#).unwrap_err();
+    match &absent {
+        RequestError::Reply(e) => {
+            assert_eq!(e.error.code, ErrorCode::Infeasible);
+            assert_eq!(e.error.details.as_ref().unwrap()["reason"], "not_found");
+        }
+        other => panic!("{other}"),
+    }
+    assert_eq!(code(ask("{not json")), Some(ErrorCode::MalformedJson));
+    assert_eq!(
+        code(ask(r#"{"object": "can_350ml", "colour": 1}"#)),
+        Some(ErrorCode::InvalidRequest)
+    );
+    assert!(ask(r#"{"object": "can_350ml", "seed": 3}"#).is_ok());
+
+    // SIGTERM: a clean exit.
+    let status = Command::new("kill")
+        .args(["-TERM", &child.0.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let start = Instant::now();
+    loop {
+        if let Some(s) = child.0.try_wait().unwrap() {
+            assert!(s.success(), "exit status {s}");
+            break;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(10),
+            "still running 10 s after SIGTERM"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    client.close();
+}

@@ -1,0 +1,58 @@
+//! A wrong or absent object is reported as not found, never as a confident pose.
+
+use std::path::PathBuf;
+
+use nalgebra::Point3;
+use tsukami_body::files::ModelRoots;
+use tsukami_vision::detect::{DetectParams, Detector, Outcome};
+use tsukami_vision::sim::testbed::Testbed;
+
+fn setup() -> (Testbed, Detector) {
+    let m = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let tb = Testbed::new(
+        &m.join("scenes/can_waist.toml"),
+        "table",
+        &m.join("objects"),
+    )
+    .unwrap();
+    (
+        tb,
+        Detector::new(ModelRoots::new([m]), DetectParams::default()),
+    )
+}
+
+#[test]
+fn empty_table() {
+    let (mut tb, mut det) = setup();
+    let centre = Point3::new(0.5 * (tb.table.x.0 + tb.table.x.1), -0.2, tb.table.z);
+    let q = tb.look_at(&centre);
+    let (image, camera) = tb.render(&[], &q, 3).unwrap();
+    for object in ["can_350ml", "pet_500ml", "box"] {
+        match det.detect(object, &image, &camera).unwrap() {
+            Outcome::NotFound(n) => assert!(!n.reason.is_empty()),
+            Outcome::Found(d) => panic!("{object} found on an empty table: {d:?}"),
+        }
+    }
+}
+
+#[test]
+fn wrong_object() {
+    let (mut tb, mut det) = setup();
+    for (shown, asked, seed) in [
+        ("can_350ml", "pet_500ml", 0),
+        ("can_350ml", "box", 1),
+        ("pet_500ml", "box", 1000),
+        ("box", "can_350ml", 2000),
+        ("box", "pet_500ml", 2001),
+    ] {
+        let trial = tb.trial(shown, None, 0.0, seed).unwrap();
+        match det.detect(asked, &trial.image, &trial.camera).unwrap() {
+            Outcome::NotFound(n) => {
+                if let Some(best) = n.best {
+                    assert!(best.confidence < 0.8, "{best:?}");
+                }
+            }
+            Outcome::Found(d) => panic!("{asked} reported in an image of {shown}: {d:?}"),
+        }
+    }
+}
