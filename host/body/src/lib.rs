@@ -31,6 +31,7 @@ pub mod collada;
 pub mod collision;
 pub mod convert;
 pub mod error;
+pub mod files;
 pub mod ik;
 pub mod kinematics;
 pub mod limits;
