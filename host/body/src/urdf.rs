@@ -20,9 +20,11 @@
 //!   continuous); on a prismatic joint the bounds are swapped;
 //! - a missing `<limit>` on a revolute joint means no limit; missing
 //!   `effort` or `velocity` are 0;
-//! - `floating` and `planar` joints are kept at their zero pose (fixed);
-//! - a `<mimic>` on a fixed joint, naming a missing or fixed joint, or in a
-//!   cycle is ignored;
+//! - `floating`, `planar` and `spherical` joints are kept at their zero pose
+//!   (fixed);
+//! - a `<mimic>` naming a missing joint holds the joint at its offset (the
+//!   master is read as 0, as yourdfpy does); one on a fixed joint, naming a
+//!   fixed joint, or in a cycle is ignored;
 //! - a negative mass is read as 0.
 //!
 //! Mesh paths: `package://PKG/rest` goes through [`PackagePath`] (in its
@@ -226,6 +228,21 @@ impl Builder<'_> {
             joints.push(self.joint(j, &order.link_of, &new_link)?);
         }
         self.mimics(&raw_joints, &mut joints)?;
+        for (j, r) in raw_joints.iter().enumerate() {
+            let Some(m) = &r.mimic else { continue };
+            let pinned = joints[j].is_movable()
+                && joints[j].mimic.is_none()
+                && !joints.iter().any(|o| o.name == m.joint);
+            if pinned {
+                // As the reference parsers read it: the missing master is at
+                // 0, so the joint is held at its offset.
+                let at = crate::kinematics::joint_motion(joints[j].kind, &joints[j].axis, m.offset);
+                joints[j].origin *= at;
+                joints[j].kind = JointKind::Fixed;
+                joints[j].limits.lower = 0.0;
+                joints[j].limits.upper = 0.0;
+            }
+        }
         Ok(RobotModel::assemble(robot.name, self.file(), links, joints))
     }
 
@@ -504,7 +521,7 @@ impl Builder<'_> {
             "continuous" => JointKind::Continuous,
             "prismatic" => JointKind::Prismatic,
             "fixed" => JointKind::Fixed,
-            "floating" | "planar" => {
+            "floating" | "planar" | "spherical" => {
                 self.d.quirk(
                     &el,
                     format!("a {} joint is kept at its zero pose (fixed)", j.kind),
@@ -611,7 +628,10 @@ impl Builder<'_> {
                 Some("a fixed joint cannot mimic".to_string())
             } else {
                 match index.get(m.joint.as_str()) {
-                    None => Some(format!("master joint '{}' does not exist", m.joint)),
+                    None => Some(format!(
+                        "master joint '{}' does not exist; the joint is held at its offset {} (fixed)",
+                        m.joint, m.offset
+                    )),
                     Some(&t) if joints[t].kind == JointKind::Fixed => {
                         Some(format!("master joint '{}' is fixed", m.joint))
                     }
@@ -622,7 +642,12 @@ impl Builder<'_> {
                 }
             };
             if let Some(p) = problem {
-                self.mimic_quirk(&joints[j].name, format!("{p}; the mimic is ignored"))?;
+                let p = if p.contains("(fixed)") {
+                    p
+                } else {
+                    format!("{p}; the mimic is ignored")
+                };
+                self.mimic_quirk(&joints[j].name, p)?;
             }
         }
         // Then follow chains to independent masters.

@@ -235,9 +235,38 @@ pub fn read_robot(xml: &str, d: &mut Diagnostics, limits: &ParseLimits) -> Resul
             )?;
             return read_document(&doc, d, limits);
         }
+        Err(e) if !d.strict => {
+            declared = repair(xml).ok_or_else(|| urdf_err(e.to_string()))?;
+            let doc = Document::parse_with_options(&declared, options)
+                .map_err(|_| urdf_err(e.to_string()))?;
+            d.quirk(
+                "robot",
+                format!(
+                    "{e}: read after dropping misplaced XML declarations and text after </robot>"
+                ),
+            )?;
+            return read_document(&doc, d, limits);
+        }
         Err(e) => return Err(urdf_err(e.to_string())),
     };
     read_document(&doc, d, limits)
+}
+
+/// The text without XML declarations (`<?xml ...?>`) and without anything
+/// after the last `</robot>`, or `None` when that changes nothing.
+fn repair(xml: &str) -> Option<String> {
+    let mut out = String::with_capacity(xml.len());
+    let mut rest = xml;
+    while let Some(i) = rest.find("<?xml") {
+        out.push_str(&rest[..i]);
+        rest = rest[i..].find("?>").map_or("", |e| &rest[i + e + 2..]);
+    }
+    out.push_str(rest);
+    if let Some(end) = out.rfind("</robot>") {
+        out.truncate(end + "</robot>".len());
+    }
+    let out = out.trim_start().to_string();
+    (out != xml).then_some(out)
 }
 
 /// Declares every `prefix:` used in element or attribute names on the root
