@@ -437,18 +437,10 @@ mod tests {
         let p = target.links["r_palm"];
         let mut t = p.position.to_vec();
         t.extend(p.quaternion);
-        let arm: Vec<String> = [
-            "r_shoulder_pitch",
-            "r_shoulder_roll",
-            "r_shoulder_yaw",
-            "r_elbow",
-            "r_wrist_yaw",
-            "r_wrist_pitch",
-            "r_wrist_roll",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+        let arm: Vec<String> = tsukami_body::ik::RIGHT_ARM
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
         let req = IkRequest {
             link: Some("r_palm".into()),
             target: t.clone(),
