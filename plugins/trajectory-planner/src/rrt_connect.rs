@@ -1,0 +1,405 @@
+//! RRT-Connect: a collision-free joint-space path between two configurations.
+//!
+//! What: [`plan`] grows one tree from the start and one from the goal and tries to
+//! connect them (J. J. Kuffner and S. M. LaValle, "RRT-Connect: An efficient
+//! approach to single-query path planning", ICRA 2000). The path it returns is a
+//! list of configurations whose straight segments are all collision-free.
+//!
+//! Why: the reach from the rest posture to a grasp is a high-dimensional query
+//! (7 arm joints, plus waist and squat) answered once; a bidirectional tree
+//! answers such queries fast, and its greedy connect step suits the mostly free
+//! space around a humanoid's arm.
+//!
+//! How: the collision test is the caller's, behind two one-method traits —
+//! [`Validity`] (is this configuration free?) and [`SegmentSteps`] (how many
+//! checks does this straight segment need?). Samples come from a ChaCha stream
+//! seeded by the caller and the budget counts samples, so the same problem and
+//! seed give the same path on any machine. Nearest neighbours are found by a linear
+//! scan, which is fast enough for the few thousand nodes a budget allows.
+//!
+//! ```
+//! use tsukami_trajectory_planner::rrt_connect::{plan, Problem, RrtParams, Validity, SegmentSteps};
+//! // A unit square with a wall at x = 0.5 that has a gap at y > 0.8.
+//! struct Wall;
+//! impl Validity for Wall {
+//!     fn is_valid(&mut self, q: &[f64]) -> bool { (q[0] - 0.5).abs() > 0.05 || q[1] > 0.8 }
+//! }
+//! struct Fine;
+//! impl SegmentSteps for Fine {
+//!     fn steps(&self, a: &[f64], b: &[f64]) -> usize { ((a[0]-b[0]).hypot(a[1]-b[1]) / 0.01).ceil().max(1.0) as usize }
+//! }
+//! let problem = Problem { lower: &[0.0, 0.0], upper: &[1.0, 1.0], start: &[0.1, 0.1], goal: &[0.9, 0.1] };
+//! let path = plan(&problem, &RrtParams::default(), &mut Wall, &Fine, &|| false).unwrap();
+//! assert_eq!(path.first().unwrap(), &vec![0.1, 0.1]);
+//! assert_eq!(path.last().unwrap(), &vec![0.9, 0.1]);
+//! ```
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Is a configuration free (no collision, within limits)?
+pub trait Validity {
+    /// True when `q` may be occupied.
+    fn is_valid(&mut self, q: &[f64]) -> bool;
+}
+
+/// How many equal steps a straight segment needs so that checking the step ends
+/// cannot miss an obstacle (see [`crate::resolution`]).
+pub trait SegmentSteps {
+    /// Number of steps (≥ 1) from `a` to `b`.
+    fn steps(&self, a: &[f64], b: &[f64]) -> usize;
+}
+
+/// A query: bounds of the space, start and goal.
+#[derive(Debug, Clone, Copy)]
+pub struct Problem<'a> {
+    /// Lower bound per dimension.
+    pub lower: &'a [f64],
+    /// Upper bound per dimension.
+    pub upper: &'a [f64],
+    /// Start configuration.
+    pub start: &'a [f64],
+    /// Goal configuration.
+    pub goal: &'a [f64],
+}
+
+/// Tuning of [`plan`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RrtParams {
+    /// Largest number of random samples drawn before giving up.
+    pub max_samples: usize,
+    /// Longest extension of a tree per step (Euclidean, joint units).
+    pub step: f64,
+    /// Seed of the sample stream.
+    pub seed: u64,
+}
+
+impl Default for RrtParams {
+    fn default() -> Self {
+        RrtParams {
+            max_samples: 5000,
+            step: 0.15,
+            seed: 0,
+        }
+    }
+}
+
+/// Why no path was found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RrtError {
+    /// The start configuration is in collision or out of bounds.
+    #[error("the start configuration is in collision or out of its limits")]
+    StartInvalid,
+    /// The goal configuration is in collision or out of bounds.
+    #[error("the goal configuration is in collision or out of its limits")]
+    GoalInvalid,
+    /// The sample budget ran out.
+    #[error("no collision-free path found within {samples} samples")]
+    Exhausted {
+        /// Samples drawn.
+        samples: usize,
+    },
+    /// The caller's cancel check said stop.
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// Checks the straight segment `a → b`, excluding `a` itself (assumed checked).
+pub fn segment_valid(
+    validity: &mut impl Validity,
+    steps: &impl SegmentSteps,
+    a: &[f64],
+    b: &[f64],
+) -> bool {
+    let n = steps.steps(a, b);
+    if n == usize::MAX {
+        return false;
+    }
+    let mut q = vec![0.0; a.len()];
+    (1..=n).all(|i| {
+        let t = i as f64 / n as f64;
+        lerp_into(a, b, t, &mut q);
+        validity.is_valid(&q)
+    })
+}
+
+/// `out = a + t (b − a)`.
+pub fn lerp_into(a: &[f64], b: &[f64], t: f64, out: &mut [f64]) {
+    for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
+        *o = x + t * (y - x);
+    }
+}
+
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// One tree: nodes and the index of each node's parent.
+struct Tree {
+    nodes: Vec<Vec<f64>>,
+    parent: Vec<usize>,
+}
+
+#[derive(PartialEq)]
+enum Extend {
+    Trapped,
+    Advanced,
+    Reached,
+}
+
+impl Tree {
+    fn new(root: &[f64]) -> Self {
+        Tree {
+            nodes: vec![root.to_vec()],
+            parent: vec![0],
+        }
+    }
+
+    fn nearest(&self, q: &[f64]) -> usize {
+        let mut best = (0, f64::INFINITY);
+        for (i, n) in self.nodes.iter().enumerate() {
+            let d = distance(n, q);
+            if d < best.1 {
+                best = (i, d);
+            }
+        }
+        best.0
+    }
+
+    /// One RRT extension towards `target`.
+    fn extend<V: Validity, S: SegmentSteps>(
+        &mut self,
+        target: &[f64],
+        step: f64,
+        validity: &mut V,
+        steps: &S,
+    ) -> Extend {
+        let near = self.nearest(target);
+        let from = &self.nodes[near];
+        let d = distance(from, target);
+        let (new, reached) = if d <= step {
+            (target.to_vec(), true)
+        } else {
+            let mut q = vec![0.0; target.len()];
+            lerp_into(from, target, step / d, &mut q);
+            (q, false)
+        };
+        if !segment_valid(validity, steps, from, &new) {
+            return Extend::Trapped;
+        }
+        self.nodes.push(new);
+        self.parent.push(near);
+        if reached {
+            Extend::Reached
+        } else {
+            Extend::Advanced
+        }
+    }
+
+    /// Root-to-node path.
+    fn path_to(&self, mut i: usize) -> Vec<Vec<f64>> {
+        let mut path = vec![self.nodes[i].clone()];
+        while i != 0 {
+            i = self.parent[i];
+            path.push(self.nodes[i].clone());
+        }
+        path.reverse();
+        path
+    }
+}
+
+/// Plans a path from `problem.start` to `problem.goal`; both ends are included.
+/// `cancelled` is polled once per sample.
+pub fn plan<V: Validity, S: SegmentSteps>(
+    problem: &Problem<'_>,
+    params: &RrtParams,
+    validity: &mut V,
+    steps: &S,
+    cancelled: &dyn Fn() -> bool,
+) -> Result<Vec<Vec<f64>>, RrtError> {
+    let in_bounds = |q: &[f64]| {
+        q.iter()
+            .zip(problem.lower.iter().zip(problem.upper))
+            .all(|(x, (lo, hi))| x >= lo && x <= hi)
+    };
+    if !in_bounds(problem.start) || !validity.is_valid(problem.start) {
+        return Err(RrtError::StartInvalid);
+    }
+    if !in_bounds(problem.goal) || !validity.is_valid(problem.goal) {
+        return Err(RrtError::GoalInvalid);
+    }
+    if segment_valid(validity, steps, problem.start, problem.goal) {
+        return Ok(vec![problem.start.to_vec(), problem.goal.to_vec()]);
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
+    let mut trees = [Tree::new(problem.start), Tree::new(problem.goal)];
+    let mut sample = vec![0.0; problem.start.len()];
+    for k in 0..params.max_samples {
+        if cancelled() {
+            return Err(RrtError::Cancelled);
+        }
+        for (s, (lo, hi)) in sample
+            .iter_mut()
+            .zip(problem.lower.iter().zip(problem.upper))
+        {
+            *s = if hi > lo {
+                rng.random_range(*lo..=*hi)
+            } else {
+                *lo
+            };
+        }
+        let a = k % 2;
+        let [ta, tb] = if a == 0 {
+            let [x, y] = &mut trees;
+            [x, y]
+        } else {
+            let [x, y] = &mut trees;
+            [y, x]
+        };
+        if ta.extend(&sample, params.step, validity, steps) == Extend::Trapped {
+            continue;
+        }
+        let newest = ta.nodes.len() - 1;
+        let target = ta.nodes[newest].clone();
+        let mut outcome = Extend::Advanced;
+        while outcome == Extend::Advanced {
+            outcome = tb.extend(&target, params.step, validity, steps);
+        }
+        if outcome == Extend::Reached {
+            let mut from_a = ta.path_to(newest);
+            let mut from_b = tb.path_to(tb.nodes.len() - 1);
+            from_b.reverse();
+            from_b.remove(0); // the connecting node appears in both
+            from_a.extend(from_b);
+            if a == 1 {
+                from_a.reverse();
+            }
+            return Ok(from_a);
+        }
+    }
+    Err(RrtError::Exhausted {
+        samples: params.max_samples,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2-D world with a wall at x ∈ [0.45, 0.55] below y = 0.8.
+    struct Wall {
+        checks: usize,
+    }
+    impl Validity for Wall {
+        fn is_valid(&mut self, q: &[f64]) -> bool {
+            self.checks += 1;
+            !((0.45..=0.55).contains(&q[0]) && q[1] < 0.8)
+        }
+    }
+    struct Res(f64);
+    impl SegmentSteps for Res {
+        fn steps(&self, a: &[f64], b: &[f64]) -> usize {
+            ((distance(a, b) / self.0).ceil() as usize).max(1)
+        }
+    }
+
+    fn problem() -> Problem<'static> {
+        Problem {
+            lower: &[0.0, 0.0],
+            upper: &[1.0, 1.0],
+            start: &[0.1, 0.1],
+            goal: &[0.9, 0.1],
+        }
+    }
+
+    #[test]
+    fn path_goes_around_the_wall_and_every_segment_is_free() {
+        let path = plan(
+            &problem(),
+            &RrtParams::default(),
+            &mut Wall { checks: 0 },
+            &Res(0.01),
+            &|| false,
+        )
+        .unwrap();
+        assert!(
+            path.iter().any(|q| q[1] >= 0.8),
+            "the path must pass the gap"
+        );
+        for w in path.windows(2) {
+            let mut fine = Wall { checks: 0 };
+            assert!(segment_valid(&mut fine, &Res(0.001), &w[0], &w[1]));
+        }
+    }
+
+    #[test]
+    fn same_seed_same_path_other_seed_other_path() {
+        let p = |seed| {
+            let params = RrtParams {
+                seed,
+                ..RrtParams::default()
+            };
+            plan(
+                &problem(),
+                &params,
+                &mut Wall { checks: 0 },
+                &Res(0.01),
+                &|| false,
+            )
+            .unwrap()
+        };
+        assert_eq!(p(3), p(3));
+        assert_ne!(p(3), p(4));
+    }
+
+    #[test]
+    fn invalid_ends_and_exhaustion_are_reported() {
+        let mut pr = problem();
+        pr.start = &[0.5, 0.1];
+        assert_eq!(
+            plan(
+                &pr,
+                &RrtParams::default(),
+                &mut Wall { checks: 0 },
+                &Res(0.01),
+                &|| false
+            ),
+            Err(RrtError::StartInvalid)
+        );
+        let mut pr = problem();
+        pr.goal = &[0.5, 0.5];
+        assert_eq!(
+            plan(
+                &pr,
+                &RrtParams::default(),
+                &mut Wall { checks: 0 },
+                &Res(0.01),
+                &|| false
+            ),
+            Err(RrtError::GoalInvalid)
+        );
+        // A wall with no gap: nothing connects.
+        struct Closed;
+        impl Validity for Closed {
+            fn is_valid(&mut self, q: &[f64]) -> bool {
+                !(0.45..=0.55).contains(&q[0])
+            }
+        }
+        let params = RrtParams {
+            max_samples: 300,
+            ..RrtParams::default()
+        };
+        assert_eq!(
+            plan(&problem(), &params, &mut Closed, &Res(0.01), &|| false),
+            Err(RrtError::Exhausted { samples: 300 })
+        );
+        assert_eq!(
+            plan(&problem(), &params, &mut Closed, &Res(0.01), &|| true),
+            Err(RrtError::Cancelled)
+        );
+    }
+}
