@@ -96,11 +96,41 @@ pub fn test_config(plugins: Vec<PluginEntryConfig>) -> HostConfig {
     config
 }
 
+/// How many fresh ports [`TestBus::start`] tries when the port it was given was
+/// taken between picking it and binding it.
+const PORT_ATTEMPTS: usize = 8;
+
+/// Whether a host failed to start because its port was already bound (the OS's
+/// `AddrInUse` message, "Address already in use (os error 98)" on Linux, as
+/// zenoh passes it on in its error chain).
+fn address_in_use(message: &str) -> bool {
+    message.contains("already in use") || message.contains("AddrInUse")
+}
+
+/// Starts a host with `config`; when its port was taken meanwhile (a free port is
+/// picked, released, then bound by the host: another test or process may bind it
+/// in between), moves the host and its namespace to a fresh port and tries again.
+fn start_host(mut config: HostConfig) -> (RunningHost, HostConfig) {
+    for attempt in 1..=PORT_ATTEMPTS {
+        match RunningHost::start(&config) {
+            Ok(host) => return (host, config),
+            Err(e) if address_in_use(&format!("{e:#}")) && attempt < PORT_ATTEMPTS => {
+                let port = free_loopback_port().expect("free port");
+                config.bus = BusConfig::listening(&format!("tcp/127.0.0.1:{port}"));
+                config.namespace = format!("test-{port}");
+            }
+            Err(e) => panic!("host starts: {e:#}"),
+        }
+    }
+    unreachable!("the last attempt returns or panics")
+}
+
 impl TestBus {
-    /// Starts a host with `config` and waits until it answers on the bus.
+    /// Starts a host with `config` and waits until it answers on the bus. A port
+    /// taken meanwhile is replaced by a fresh one (see [`start_host`]).
     pub fn start(config: HostConfig) -> TestBus {
+        let (host, config) = start_host(config);
         let endpoint = config.bus.listen[0].clone();
-        let host = RunningHost::start(&config).expect("host starts");
         let client = BusClient::connect(&BusConfig::connecting(&endpoint), &config.namespace)
             .expect("client connects");
         client
@@ -180,4 +210,24 @@ pub fn cli_plugins_listing(endpoint: &str, namespace: &str) -> serde_json::Value
         }
     }
     panic!("`tsukami plugins` never got an answer from {endpoint}");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_port_taken_before_the_host_binds_it_is_replaced() {
+        // Someone else holds the port the config names.
+        let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+        let port = taken.local_addr().unwrap().port();
+        let mut config = test_config(vec![]);
+        let endpoint = format!("tcp/127.0.0.1:{port}");
+        config.bus = BusConfig::listening(&endpoint);
+        let bus = TestBus::start(config);
+        assert_ne!(bus.endpoint, endpoint);
+        let listing = bus.client.wait_for_host(Duration::from_secs(20)).unwrap();
+        assert!(listing.plugins.is_empty());
+        drop(taken);
+    }
 }

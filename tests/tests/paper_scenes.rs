@@ -1,7 +1,9 @@
 //! The paper's scenes over a real zenoh bus: a host with the real grasp-planner
 //! plugin file, driven with SetRobot / SetObject / SetEnv / Plan as any client would,
-//! each reply judged against what the paper reports (`tsukami-scenes`), including
-//! the exact force-closure verdict with the object's weight.
+//! each reply judged against what the paper reports and by the independent grasp
+//! check (`tsukami-scenes`): the exact force-closure test with the object's weight
+//! recomputed from the reply, contacts on the surface, no link more than 1 mm inside
+//! the object or an obstacle, joint limits and `joints_used`.
 
 use std::time::Duration;
 use tsukami::scenes::run_scene;
@@ -25,9 +27,19 @@ fn plan_paper_scene(name: &str) {
             outcome.problem,
             serde_json::to_string_pretty(&outcome).unwrap()
         );
+        // `ok` includes the independent check (`tsukami_scenes::verify`): the exact
+        // test recomputed here from the reply's contacts and stated force limit.
+        let held = outcome.weight_scale.expect("the checker's weight scale");
+        assert!(
+            held >= 1.0,
+            "{name} (seed {seed}): holds {held} x its weight"
+        );
         let reply = outcome.result.as_ref().unwrap();
-        assert!(reply.force_closure.exact_resists_weight);
-        assert!(!reply.contacts.is_empty() && reply.joint_positions.contains_key("r_wrist_roll"));
+        assert!(reply.contacts.len() >= 2 && reply.joint_positions.contains_key("r_wrist_roll"));
+        if scene.arm_alone_fails {
+            let arm = outcome.arm_only.as_deref().unwrap_or_default();
+            assert!(arm.contains("infeasible"), "{name}: arm alone: {arm}");
+        }
     }
 }
 

@@ -223,9 +223,27 @@ mod tests {
     #[test]
     fn default_config_parses() {
         let config = HostConfig::default_config().unwrap();
-        assert_eq!(config.namespace, "tsukami");
-        assert_eq!(config.bus.listen, vec!["tcp/127.0.0.1:17447".to_owned()]);
-        assert_eq!(config.plugins[0].role, "grasp-planner");
+        // It listens on loopback only: every endpoint is a 127.0.0.0/8 socket address.
+        assert!(!config.bus.listen.is_empty());
+        for endpoint in &config.bus.listen {
+            let addr: std::net::SocketAddr = endpoint
+                .strip_prefix("tcp/")
+                .and_then(|a| a.parse().ok())
+                .unwrap_or_else(|| panic!("{endpoint} is not a tcp socket address"));
+            assert!(addr.ip().is_loopback(), "{endpoint} is not loopback");
+        }
+        // The planner gets a models folder that really holds the project's robot
+        // (resolved from the executable's location, not written in the config).
+        let planner = config
+            .plugins
+            .iter()
+            .find(|p| p.role == "grasp-planner")
+            .expect("a grasp-planner entry");
+        let models = planner.config.as_ref().unwrap()["models_dir"]
+            .as_str()
+            .unwrap();
+        let urdf = Path::new(models).join("robots/tsukami_humanoid/tsukami_humanoid.urdf");
+        assert!(urdf.is_file(), "{} does not exist", urdf.display());
     }
 
     #[test]

@@ -111,10 +111,11 @@ fn print_table(outcomes: &[SceneOutcome]) {
                     r.joints_used.join(",")
                 },
                 format!("{:.3}", r.force_closure.margin),
-                if r.force_closure.exact_resists_weight {
-                    "holds"
-                } else {
-                    "FAILS"
+                // Recomputed by the independent check, never the planner's flag.
+                match o.weight_scale {
+                    Some(s) if s >= 1.0 => "holds",
+                    Some(_) => "FAILS",
+                    None => "-",
                 }
                 .to_owned(),
             ),

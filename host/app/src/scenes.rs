@@ -1,15 +1,21 @@
 //! Runs the paper's scenes against a planner over the bus, exactly as an external
 //! client would: SetRobot, SetObject, SetEnv, Plan — and judges each reply against
-//! what the paper reports (`tsukami-scenes`). Used by `tsukami demo` and the
-//! end-to-end tests.
+//! what the paper reports and with the independent grasp check, in the world the
+//! requests describe (`tsukami-scenes`: force closure recomputed, contacts on the
+//! surface, no link sunk into the object or an obstacle, joint limits). Used by
+//! `tsukami demo` and the end-to-end tests.
 
-use crate::client::BusClient;
+use crate::client::{BusClient, RequestError};
 use serde::Serialize;
 use std::path::Path;
 use std::time::{Duration, Instant};
 use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER};
 use tsukami_msgs::planner::{ObjectSummary, PlanOptions, PlanReply, WholeBody};
-use tsukami_scenes::{scene_requests, PaperScene};
+use tsukami_msgs::ErrorCode;
+use tsukami_scenes::{scene_requests, verify, PaperScene, Tolerances, World};
+
+/// The `details.reason` of the planner's error when no palm pose is reachable.
+pub const UNREACHABLE_REASON: &str = "unreachable";
 
 /// What happened to one scene.
 #[derive(Debug, Clone, Serialize)]
@@ -32,6 +38,11 @@ pub struct SceneOutcome {
     pub arm_only: Option<String>,
     /// Round trip of the Plan request, milliseconds.
     pub plan_ms: f64,
+    /// The largest multiple of the object's weight the reply's contacts hold,
+    /// recomputed by the independent check (`tsukami_scenes::verify`), not read
+    /// from the reply.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weight_scale: Option<f64>,
 }
 
 fn send<T: Serialize>(
@@ -40,10 +51,40 @@ fn send<T: Serialize>(
     request: &T,
     timeout: Duration,
 ) -> Result<Vec<u8>, String> {
-    let payload = serde_json::to_vec(request).map_err(|e| e.to_string())?;
-    client
-        .command(ROLE_GRASP_PLANNER, command, &payload, timeout)
-        .map_err(|e| format!("{command}: {e}"))
+    send_raw(client, command, request, timeout).map_err(|e| format!("{command}: {e}"))
+}
+
+fn send_raw<T: Serialize>(
+    client: &BusClient,
+    command: &str,
+    request: &T,
+    timeout: Duration,
+) -> Result<Vec<u8>, RequestError> {
+    let payload = serde_json::to_vec(request).map_err(|e| RequestError::Bus {
+        key: command.to_owned(),
+        message: format!("cannot serialize the request: {e}"),
+    })?;
+    client.command(ROLE_GRASP_PLANNER, command, &payload, timeout)
+}
+
+/// `Ok` when a plan with the arm alone failed the way the paper says: `infeasible`
+/// because the object is unreachable (not a timeout, not a refused request).
+pub fn arm_alone_failed(result: &Result<Vec<u8>, RequestError>) -> Result<(), String> {
+    let e = match result {
+        Ok(_) => return Err("the arm alone found a grasp; the paper says it cannot".to_owned()),
+        Err(e) => e,
+    };
+    let reason = match e {
+        RequestError::Reply(r) => r.error.details.as_ref().and_then(|d| d["reason"].as_str()),
+        _ => None,
+    };
+    if e.code() == Some(ErrorCode::Infeasible) && reason == Some(UNREACHABLE_REASON) {
+        Ok(())
+    } else {
+        Err(format!(
+            "the arm-only plan must fail as infeasible/{UNREACHABLE_REASON}, it failed with: {e} (reason {reason:?})"
+        ))
+    }
 }
 
 /// Sets the planner up for `scene` and plans it with `seed`.
@@ -63,6 +104,7 @@ pub fn run_scene(
         regions: 0,
         arm_only: None,
         plan_ms: 0.0,
+        weight_scale: None,
     };
     if let Err(problem) = plan_scene(client, models_dir, scene, seed, timeout, &mut outcome) {
         outcome.problem = Some(problem);
@@ -82,6 +124,8 @@ fn plan_scene(
         .join("scenes")
         .join(format!("{}.toml", scene.name));
     let requests = scene_requests(&file).map_err(|e| e.to_string())?;
+    let world = World::from_requests(models_dir, &requests.robot, &requests.object, &requests.env)
+        .map_err(|e| format!("the checker's world: {e}"))?;
     send(client, planner::SET_ROBOT, &requests.robot, timeout)?;
     let object: ObjectSummary = serde_json::from_slice(&send(
         client,
@@ -99,10 +143,9 @@ fn plan_scene(
             whole_body: WholeBody::ArmOnly,
             ..PlanOptions::default()
         };
-        match send(client, planner::PLAN, &arm_only, timeout) {
-            Ok(_) => return Err("the arm alone found a grasp; the paper says it cannot".to_owned()),
-            Err(e) => outcome.arm_only = Some(e),
-        }
+        let result = send_raw(client, planner::PLAN, &arm_only, timeout);
+        arm_alone_failed(&result)?;
+        outcome.arm_only = result.err().map(|e| format!("plan: {e}"));
     }
 
     let options = PlanOptions {
@@ -114,7 +157,9 @@ fn plan_scene(
     outcome.plan_ms = start.elapsed().as_secs_f64() * 1e3;
     let reply: PlanReply =
         serde_json::from_slice(&reply?).map_err(|e| format!("plan reply: {e}"))?;
-    let verdict = scene.check(&reply, outcome.regions);
+    let verdict = verify(&world, &reply, &Tolerances::default());
+    outcome.weight_scale = verdict.weight_scale;
+    let verdict = scene.judge(&reply, outcome.regions, &verdict);
     outcome.result = Some(reply);
     verdict?;
     outcome.ok = true;

@@ -498,8 +498,15 @@ pub struct ForceClosureReply {
     /// Ellipsoid margin `n − f(p1..pn)` of eq. (10) for the object's weight.
     pub margin: f64,
     /// Exact friction-cone test (second-order cone program): the contacts, each
-    /// within its friction cone and its `f_max`, can resist the weight.
+    /// within its friction cone and pressing at most `force_limit`, can resist
+    /// the weight.
     pub exact_resists_weight: bool,
+    /// The one normal-force bound (N) the planner applied to every contact in
+    /// both tests: the weakest contact's `f_max` (the paper's single maximum
+    /// finger force). An independent checker recomputes the exact test with it
+    /// (`tsukami_scenes::verify`); 0 in replies of planners that predate it.
+    #[serde(default)]
+    pub force_limit: f64,
 }
 
 /// Time spent per phase, milliseconds.
@@ -598,9 +605,9 @@ pub struct ProgressEvent {
 mod tests {
     use super::*;
 
-    #[test]
-    fn plan_reply_field_contract() {
-        let reply = PlanReply {
+    /// A reply with every field set.
+    fn sample_reply() -> PlanReply {
+        PlanReply {
             grasp_type: GraspTypeRef {
                 name: "fingertip4_mid".into(),
                 style: GraspStyle::Fingertip4,
@@ -626,11 +633,17 @@ mod tests {
             force_closure: ForceClosureReply {
                 margin: 0.3,
                 exact_resists_weight: true,
+                force_limit: 5.0,
             },
             samples: 3,
             timing_ms: PhaseTiming::default(),
             candidates_tried: vec![],
-        };
+        }
+    }
+
+    #[test]
+    fn plan_reply_field_contract() {
+        let reply = sample_reply();
         let v = serde_json::to_value(&reply).unwrap();
         assert_eq!(v["grasp_type"]["style"], "fingertip4");
         assert_eq!(v["grasp_type"]["size"], "mid");
@@ -666,10 +679,69 @@ mod tests {
         assert_eq!(env.obstacles[0].pose.quaternion, [0.0, 0.0, 0.0, 1.0]);
     }
 
+    /// Follows `$ref` (and a lone `allOf: [$ref]`) to the definition it names.
+    fn resolve<'a>(
+        node: &'a serde_json::Value,
+        root: &'a serde_json::Value,
+    ) -> &'a serde_json::Value {
+        let reference = node["$ref"]
+            .as_str()
+            .or_else(|| node["allOf"][0]["$ref"].as_str());
+        match reference {
+            Some(r) => {
+                let name = r.rsplit('/').next().unwrap();
+                let defs = if root["$defs"].is_object() {
+                    &root["$defs"]
+                } else {
+                    &root["definitions"]
+                };
+                resolve(&defs[name], root)
+            }
+            None => node,
+        }
+    }
+
+    /// Every object in `value` has exactly the properties its schema lists, and
+    /// all the required ones; recurses into properties and array items.
+    fn matches_schema(
+        path: &str,
+        node: &serde_json::Value,
+        value: &serde_json::Value,
+        root: &serde_json::Value,
+    ) {
+        let node = resolve(node, root);
+        if let (Some(props), Some(object)) = (node["properties"].as_object(), value.as_object()) {
+            let listed: std::collections::BTreeSet<&String> = props.keys().collect();
+            let present: std::collections::BTreeSet<&String> = object.keys().collect();
+            assert_eq!(
+                listed, present,
+                "{path}: schema properties vs serialized fields"
+            );
+            for required in node["required"].as_array().into_iter().flatten() {
+                assert!(
+                    object.contains_key(required.as_str().unwrap()),
+                    "{path}: {required} missing"
+                );
+            }
+            for (key, v) in object {
+                matches_schema(&format!("{path}.{key}"), &props[key], v, root);
+            }
+        }
+        if let (Some(items), Some(array)) = (node.get("items"), value.as_array()) {
+            for (i, v) in array.iter().enumerate() {
+                matches_schema(&format!("{path}[{i}]"), items, v, root);
+            }
+        }
+    }
+
     #[test]
     fn schema_is_generated() {
-        let schema = schemars::schema_for!(PlanReply);
-        let text = serde_json::to_string(&schema).unwrap();
-        assert!(text.contains("characteristic_length"));
+        // The published schema describes what a reply really serializes to: the
+        // same fields at every level (a renamed, added or skipped field shows up).
+        let schema = serde_json::to_value(schemars::schema_for!(PlanReply)).unwrap();
+        let reply = serde_json::to_value(sample_reply()).unwrap();
+        matches_schema("plan_reply", &schema, &reply, &schema);
+        let limit = &resolve(&schema["properties"]["force_closure"], &schema)["properties"];
+        assert!(limit["force_limit"].is_object(), "{limit}");
     }
 }

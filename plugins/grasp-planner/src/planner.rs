@@ -56,7 +56,9 @@ use crate::hand::HandModel;
 use crate::object::{PlanObject, MAX_TRIANGLES};
 use crate::ocp::OcpParams;
 use crate::palm_pose::{criterion_value, palm_targets};
-use crate::search::{search, to_array, Counters, Outcome, SearchContext, SearchParams};
+use crate::search::{
+    hand_force_limit, search, to_array, Counters, Outcome, SearchContext, SearchParams,
+};
 use crate::selection::select;
 use crate::whole_body::stages;
 
@@ -664,6 +666,7 @@ impl Planner {
                             force_closure: ForceClosureReply {
                                 margin: found.margin,
                                 exact_resists_weight: found.exact_resists_weight,
+                                force_limit: hand_force_limit(&found.contacts),
                             },
                             samples: counters.samples,
                             timing_ms: timing,

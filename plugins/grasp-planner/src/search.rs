@@ -335,13 +335,7 @@ pub fn make_grasp(object: &PlanObject, contacts: &[FingerContact]) -> Option<Gra
         .iter()
         .map(|c| Contact::new(c.position, c.normal).ok())
         .collect::<Option<Vec<_>>>()?;
-    // The paper's single "maximum finger force" of the hand: the weakest finger's.
-    let f_hand = contacts
-        .iter()
-        .map(|c| c.f_max)
-        .fold(f64::INFINITY, f64::min)
-        .max(1e-6);
-    let limits = vec![f_hand; contacts.len()];
+    let limits = vec![hand_force_limit(contacts); contacts.len()];
     Grasp::with_force_limits(
         cs,
         limits,
@@ -350,6 +344,17 @@ pub fn make_grasp(object: &PlanObject, contacts: &[FingerContact]) -> Option<Gra
         object.center_of_mass,
     )
     .ok()
+}
+
+/// The paper's single "maximum finger force" of the hand, applied to every
+/// contact: the weakest finger's `f_max` (N). Replies state it
+/// (`ForceClosureReply::force_limit`) so a checker can recompute the tests.
+pub fn hand_force_limit(contacts: &[FingerContact]) -> f64 {
+    contacts
+        .iter()
+        .map(|c| c.f_max)
+        .fold(f64::INFINITY, f64::min)
+        .max(1e-6)
 }
 
 /// Eq. (10) margin `n − f(p1..pn)` for the object's weight.

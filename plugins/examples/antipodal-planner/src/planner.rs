@@ -510,6 +510,7 @@ impl AntipodalPlanner {
                     force_closure: ForceClosureReply {
                         margin,
                         exact_resists_weight: exact_ok,
+                        force_limit: force_limit(&contacts),
                     },
                     samples,
                     timing_ms: timing,
@@ -648,6 +649,15 @@ impl AntipodalPlanner {
     }
 }
 
+/// The one normal-force bound applied to every contact: the weakest finger's
+/// `f_max` (N), stated in the reply (`ForceClosureReply::force_limit`).
+pub fn force_limit(contacts: &[FingerContact]) -> f64 {
+    contacts
+        .iter()
+        .map(|c| c.f_max)
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// The ellipsoid margin of eq. (10) and the exact test's verdict for the
 /// object's weight; `None` when the contacts do not make a valid grasp.
 pub fn force_closure(object: &PlanObject, contacts: &[FingerContact]) -> Option<(f64, bool)> {
@@ -655,7 +665,7 @@ pub fn force_closure(object: &PlanObject, contacts: &[FingerContact]) -> Option<
         .iter()
         .map(|c| Contact::new(c.position, c.normal).ok())
         .collect::<Option<Vec<_>>>()?;
-    let limits = contacts.iter().map(|c| c.f_max).collect();
+    let limits = vec![force_limit(contacts); contacts.len()];
     let grasp = Grasp::with_force_limits(
         cs,
         limits,

@@ -9,7 +9,7 @@ use tsukami_antipodal_planner::AntipodalPlugin;
 use tsukami_msgs::planner::PlanReply;
 use tsukami_plugin_api::offline::OfflineHost;
 use tsukami_plugin_api::{CallContext, CallError, Host, Plugin};
-use tsukami_scenes::scene_requests;
+use tsukami_scenes::{scene_requests, verify, SceneRequests, Tolerances, World};
 
 fn models() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../models")
@@ -29,6 +29,14 @@ fn json<T: serde::Serialize>(v: &T) -> Vec<u8> {
 
 fn details(e: &CallError) -> serde_json::Value {
     serde_json::from_str(&e.details_json).unwrap()
+}
+
+/// The reply's grasp holds in the world `req` describes, by the independent
+/// checker (exact test recomputed, contacts on the can, no link sunk in).
+fn assert_holds(req: &SceneRequests, reply: &PlanReply) {
+    let world = World::from_requests(&models(), &req.robot, &req.object, &req.env).unwrap();
+    let verdict = verify(&world, reply, &Tolerances::default());
+    assert!(verdict.is_ok(), "{verdict}");
 }
 
 #[test]
@@ -56,7 +64,7 @@ fn plans_can_breast_through_the_plugin_interface() {
 
     let reply: PlanReply =
         serde_json::from_slice(&plugin.call("plan", br#"{"seed": 3}"#, &ctx).unwrap()).unwrap();
-    assert!(reply.force_closure.exact_resists_weight);
+    assert_holds(&req, &reply);
     assert_eq!(reply.contacts.len(), 3);
     let events = rec.progress();
     assert!(!events.is_empty());
@@ -135,20 +143,42 @@ fn bad_input_names_the_field_and_keeps_state() {
         (reply.object.mass - 0.15).abs() < 1e-12,
         "object was replaced by a bad request"
     );
-    assert!(reply.force_closure.exact_resists_weight);
+    assert_holds(&req, &reply);
 }
 
 #[test]
-fn a_raised_cancel_flag_stops_the_plan() {
-    let (_rec, host, mut plugin) = setup();
+fn a_cancel_raised_mid_plan_stops_it() {
+    let (rec, host, mut plugin) = setup();
     let cancel = AtomicBool::new(false);
     let ctx = CallContext::new(&cancel, &host);
     let req = scene_requests(&models().join("scenes/can_breast.toml")).unwrap();
     plugin.call("set_robot", &json(&req.robot), &ctx).unwrap();
-    plugin.call("set_object", &json(&req.object), &ctx).unwrap();
-    cancel.store(true, std::sync::atomic::Ordering::Relaxed);
-    let e = plugin.call("plan", b"{}", &ctx).unwrap_err();
+    // A nearly frictionless can: no sample can hold it, so only the cancel flag
+    // (raised once the plan has reported progress) ends the search early.
+    let mut slippery = req.object.clone();
+    slippery.friction = Some(0.01);
+    plugin.call("set_object", &json(&slippery), &ctx).unwrap();
+    let max_samples = 200_000;
+    let options = format!(r#"{{"max_samples": {max_samples}}}"#);
+    let e = std::thread::scope(|s| {
+        s.spawn(|| {
+            // Wait for the plan's first progress event, then raise the flag.
+            while rec.progress().is_empty() {
+                std::thread::yield_now();
+            }
+            cancel.store(true, std::sync::atomic::Ordering::Relaxed);
+        });
+        plugin.call("plan", options.as_bytes(), &ctx).unwrap_err()
+    });
     assert_eq!(e.code, "cancelled", "{e}");
+    // It stopped in the middle: after some progress, well before its budget.
+    let events = rec.progress();
+    assert!(!events.is_empty());
+    let last: serde_json::Value = serde_json::from_slice(events.last().unwrap()).unwrap();
+    assert!(
+        last["samples"].as_u64().unwrap() < max_samples,
+        "last progress {last}"
+    );
 }
 
 #[test]
