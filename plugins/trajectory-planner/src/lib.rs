@@ -8,9 +8,11 @@
 //! - [`shortcut`]: random shortcut smoothing of a collision-free path;
 //! - [`resolution`]: how finely a straight joint-space segment must be checked so
 //!   that no point of any link moves more than a stated distance between checks;
+//! - [`checker`]: a robot among obstacles as the trees' collision test;
 //! - [`timing`]: time scaling of a piecewise-linear path within every joint's
 //!   velocity limit and an acceleration limit.
 
+pub mod checker;
 pub mod resolution;
 pub mod rrt_connect;
 pub mod shortcut;
