@@ -65,11 +65,17 @@ fn main() {
                     d.verdict
                 );
             }
-            Outcome::NotFound(n) => println!(
-                "NOT FOUND: {} best {:?}",
-                n.reason,
-                n.best.map(|b| (b.pose, b.verdict))
-            ),
+            Outcome::NotFound(n) => {
+                if let (Some(b), true) = (&n.best, a.iter().any(|x| x == "--save")) {
+                    let tpl = det.template(&asked).unwrap();
+                    overlay(&t, &tpl.points, &b.pose);
+                }
+                println!(
+                    "NOT FOUND: {} best {:?}",
+                    n.reason,
+                    n.best.map(|b| (b.pose, b.verdict))
+                )
+            }
         }
     }
     if a.iter().any(|x| x == "--save") {

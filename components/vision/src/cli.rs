@@ -63,7 +63,7 @@ enum Command {
         #[command(flatten)]
         models: Models,
         /// Scene file the simulated head camera renders when a request has no
-        /// image (default: <models>/scenes/can_waist.toml).
+        /// image (default: <models>/scenes/can_breast.toml).
         #[arg(long)]
         scene: Option<PathBuf>,
         /// No simulated camera: requests must carry an image.
@@ -140,7 +140,7 @@ fn run(command: Command) -> anyhow::Result<i32> {
             let camera = if no_camera {
                 None
             } else {
-                let path = scene.unwrap_or_else(|| root.join("scenes/can_waist.toml"));
+                let path = scene.unwrap_or_else(|| root.join("scenes/can_breast.toml"));
                 Some(SceneCamera::load(&path, NoiseModel::default())?)
             };
             let service =
@@ -211,16 +211,22 @@ fn run(command: Command) -> anyhow::Result<i32> {
             };
             match service.handle(&req) {
                 Ok(h) => {
-                    println!("{}", serde_json::to_string_pretty(&h.pose)?);
+                    print_out(&serde_json::to_string_pretty(&h.pose)?);
                     Ok(0)
                 }
                 Err(e) => {
-                    println!("{}", serde_json::to_string_pretty(&e)?);
+                    print_out(&serde_json::to_string_pretty(&e)?);
                     Ok(1)
                 }
             }
         }
     }
+}
+
+/// Prints a line; a closed stdout (`| head`) is not an error.
+fn print_out(text: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stdout(), "{text}");
 }
 
 fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> anyhow::Result<T> {

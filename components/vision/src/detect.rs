@@ -8,8 +8,9 @@
 //! measures.
 //!
 //! How: back-project every `stride`-th pixel, remove the large horizontal
-//! planes (RANSAC), cluster the rest on the pixel grid, keep clusters no larger
-//! than the object; for each, try every principal-axis hypothesis with a short
+//! planes (RANSAC), cluster the rest on the pixel grid (and split each cluster
+//! again with a smaller gap, since an occluder close in front of the target
+//! joins it), keep pieces no larger than the object; for each, try every principal-axis hypothesis with a short
 //! coarse ICP, refine the best two with a full ICP, then gather the
 //! full-resolution points around the fitted model and refine once more; the
 //! candidate with the highest verified confidence wins, reported in its
@@ -225,12 +226,14 @@ pub fn detect_with(
     }
     let planes = find_planes(&cloud.points, &params.plane);
     let size_limit = template.radius * 1.25 + 0.01;
-    let clusters = segment(&cloud, &planes, image.width(), params);
-    let segments = candidate_sets(&clusters, size_limit, params.max_clusters);
+    let (clusters, pieces) = segment(&cloud, &planes, image.width(), params);
+    let segments = candidate_sets(&pieces, size_limit);
     let t_segment = started.elapsed();
     let coarse = coarse_fits(template, &segments, &camera.centre(), params);
     let t_coarse = started.elapsed();
-    let best = best_fine(template, &segments, &coarse, image, camera, &planes, params);
+    let best = best_fine(
+        template, &segments, &clusters, &coarse, image, camera, &planes, params,
+    );
     tracing::debug!(
         object = %template.name,
         points = cloud.len(),
@@ -291,14 +294,16 @@ fn explain(v: &Verdict, min_confidence: f64) -> String {
 /// cluster index, fit).
 fn coarse_fits(
     template: &ObjectTemplate,
-    segments: &[Vec<Point3<f64>>],
+    segments: &[&Segment],
     cam: &Point3<f64>,
     params: &DetectParams,
 ) -> Vec<(f64, usize, IcpFit)> {
     let mut coarse: Vec<(f64, usize, IcpFit)> = Vec::new();
     for (si, seg) in segments.iter().enumerate() {
-        let Some(m) = Moments::of(seg) else { continue };
-        let pts = thin(seg, params.coarse_points);
+        let Some(m) = Moments::of(&seg.points) else {
+            continue;
+        };
+        let pts = thin(&seg.points, params.coarse_points);
         let mut fits: Vec<(f64, usize, IcpFit)> = from_principal_axes(template, &m, cam)
             .into_iter()
             .map(|h| {
@@ -315,9 +320,11 @@ fn coarse_fits(
 
 /// The verified fine fit of highest confidence among the best `max_fine`
 /// coarse fits (stopping early at `early_accept`).
+#[allow(clippy::too_many_arguments)]
 fn best_fine(
     template: &ObjectTemplate,
-    segments: &[Vec<Point3<f64>>],
+    segments: &[&Segment],
+    clusters: &[Vec<Point3<f64>>],
     coarse: &[(f64, usize, IcpFit)],
     image: &DepthImage,
     camera: &Camera,
@@ -328,7 +335,8 @@ fn best_fine(
     for (_, si, c) in coarse.iter().take(params.max_fine) {
         let cand = fine_fit(
             template,
-            &segments[*si],
+            &segments[*si].points,
+            &clusters[segments[*si].parent],
             c.pose,
             image,
             camera,
@@ -351,13 +359,20 @@ fn best_fine(
     best
 }
 
-/// The off-plane points of the strided cloud, clustered; largest first.
+/// A cluster, or a piece of one, and the index of its whole cluster.
+struct Segment {
+    points: Vec<Point3<f64>>,
+    parent: usize,
+}
+
+/// The off-plane points of the strided cloud, clustered (largest first), and
+/// each cluster's pieces when a smaller gap splits it.
 fn segment(
     cloud: &PointCloud,
     planes: &[FoundPlane],
     width: u32,
     params: &DetectParams,
-) -> Vec<Vec<Point3<f64>>> {
+) -> (Vec<Vec<Point3<f64>>>, Vec<Segment>) {
     let s = params.stride.max(1);
     let gw = width.div_ceil(s) as usize;
     let gh = cloud
@@ -379,10 +394,39 @@ fn segment(
             grid[v as usize * gw + u as usize] = Some(*p);
         }
     }
-    cluster::clusters(&grid, gw, params.cluster_gap, params.min_cluster_points)
+    let (mut parents, mut out) = (Vec::new(), Vec::new());
+    for (pi, parent) in cluster::clusters(&grid, gw, params.cluster_gap, params.min_cluster_points)
         .into_iter()
-        .map(|c| c.into_iter().filter_map(|i| grid[i]).collect())
-        .collect()
+        .take(params.max_clusters)
+        .enumerate()
+    {
+        // Split again with a smaller gap: an occluder standing close in front
+        // of the target joins it at first.
+        let mut sub = vec![None; grid.len()];
+        for &i in &parent {
+            sub[i] = grid[i];
+        }
+        let children = cluster::clusters(
+            &sub,
+            gw,
+            params.cluster_gap * 0.6,
+            params.min_cluster_points,
+        );
+        let points =
+            |c: &[usize]| -> Vec<Point3<f64>> { c.iter().filter_map(|&i| grid[i]).collect() };
+        parents.push(points(&parent));
+        out.push(Segment {
+            points: points(&parent),
+            parent: pi,
+        });
+        if children.len() > 1 {
+            out.extend(children.iter().map(|c| Segment {
+                points: points(c),
+                parent: pi,
+            }));
+        }
+    }
+    (parents, out)
 }
 
 /// Largest distance of a point from the centroid (infinite for < 3 points).
@@ -396,25 +440,22 @@ fn extent(points: &[Point3<f64>]) -> f64 {
     }
 }
 
-/// The object-sized clusters among the largest `max`.
-fn candidate_sets(
-    segments: &[Vec<Point3<f64>>],
-    size_limit: f64,
-    max: usize,
-) -> Vec<Vec<Point3<f64>>> {
+/// The object-sized segments.
+fn candidate_sets(segments: &[Segment], size_limit: f64) -> Vec<&Segment> {
     segments
         .iter()
-        .take(max)
-        .filter(|s| extent(s) <= size_limit)
-        .cloned()
+        .filter(|s| extent(&s.points) <= size_limit)
         .collect()
 }
 
-/// Full ICP from a coarse pose, again on the gathered full-resolution points,
-/// then verification.
+/// Full ICP from a coarse pose on `seg`, again on the gathered
+/// full-resolution points, then verification against the `whole` cluster
+/// `seg` is a piece of.
+#[allow(clippy::too_many_arguments)]
 fn fine_fit(
     template: &ObjectTemplate,
     seg: &[Point3<f64>],
+    whole: &[Point3<f64>],
     start: Isometry3<f64>,
     image: &DepthImage,
     camera: &Camera,
@@ -434,7 +475,7 @@ fn fine_fit(
     } else {
         fit
     };
-    let mut verdict = verify(template, &fit.pose, seg, image, camera, &params.verify);
+    let mut verdict = verify(template, &fit.pose, whole, image, camera, &params.verify);
     let gap = rest_gap(template, &fit.pose, planes);
     verdict.resting = gap.is_some_and(|g| g >= -params.max_penetration && g <= params.max_rest_gap);
     if params.require_support && !verdict.resting {

@@ -9,7 +9,9 @@
 //!
 //! How:
 //! - *explained*: the fraction of the segment's measured points within
-//!   `inlier` of the model's surface. A wrong shape leaves many unexplained.
+//!   `inlier` of the model's surface, or well in front of it (an occluder
+//!   the segmentation could not separate). A wrong shape leaves many
+//!   unexplained.
 //! - *free space*: the model's camera-facing surface samples are projected
 //!   into the image (a z-buffer keeps the nearest per pixel). Where the camera
 //!   measured a depth well *behind* the model's surface, it saw through where
@@ -91,6 +93,52 @@ impl Verdict {
     }
 }
 
+/// The fraction of `segment` within `inlier` of the model's surface, or in
+/// front of it (an occluder merged into the segment: nearer to the camera than
+/// the model's surface at its pixel, by more than `free_space`).
+fn explained_fraction(
+    template: &ObjectTemplate,
+    inv: &Isometry3<f64>,
+    segment: &[Point3<f64>],
+    camera: &Camera,
+    splats: &[(u32, f64)],
+    params: &VerifyParams,
+) -> f64 {
+    let gate2 = params.inlier * params.inlier;
+    let k = &camera.intrinsics;
+    let model_z = |u: u32, v: u32| -> Option<f64> {
+        let mut best: Option<f64> = None;
+        for dv in -1i64..=1 {
+            for du in -1i64..=1 {
+                let (uu, vv) = (u as i64 + du, v as i64 + dv);
+                if uu < 0 || vv < 0 || uu >= k.width as i64 || vv >= k.height as i64 {
+                    continue;
+                }
+                let key = vv as u32 * k.width + uu as u32;
+                if let Ok(i) = splats.binary_search_by_key(&key, |s| s.0) {
+                    best = Some(best.map_or(splats[i].1, |b: f64| b.max(splats[i].1)));
+                }
+            }
+        }
+        best
+    };
+    let cam_inv = camera.pose.inverse();
+    let count = segment
+        .iter()
+        .filter(|p| {
+            if template.nearest(&(inv * *p)).1 <= gate2 {
+                return true;
+            }
+            let pc = cam_inv * *p;
+            match k.pixel_of(&pc).and_then(|(u, v)| model_z(u, v)) {
+                Some(z) => pc.z < z - params.free_space,
+                None => false,
+            }
+        })
+        .count();
+    count as f64 / segment.len().max(1) as f64
+}
+
 /// Scores `pose` of `template` against the `segment` points (base frame) it
 /// was fitted to and the image they came from.
 pub fn verify(
@@ -102,13 +150,6 @@ pub fn verify(
     params: &VerifyParams,
 ) -> Verdict {
     let inv = pose.inverse();
-    let gate2 = params.inlier * params.inlier;
-    let explained = segment
-        .iter()
-        .filter(|p| template.nearest(&(inv * *p)).1 <= gate2)
-        .count() as f64
-        / segment.len().max(1) as f64;
-
     // Z-buffer of the camera-facing samples.
     let cam_obj = inv * camera.centre();
     let to_cam = camera.pose.inverse() * pose;
@@ -124,6 +165,7 @@ pub fn verify(
     }
     splats.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     splats.dedup_by_key(|s| s.0);
+    let explained = explained_fraction(template, &inv, segment, camera, &splats, params);
     let mut verdict = Verdict {
         explained,
         ..Verdict::default()

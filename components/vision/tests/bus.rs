@@ -70,7 +70,7 @@ fn vision_component_over_the_bus() {
         .wait()
         .unwrap();
 
-    // The can of models/scenes/can_waist.toml stands at (0.36, -0.25, 0.78).
+    // The can of models/scenes/can_breast.toml (the default scene) stands at (0.52, -0.25, 1.10).
     let key = format!("{ns}/vision/detect");
     let ask = |body: &str| client.request_key(&key, body.as_bytes(), Duration::from_secs(60));
     let reply: ObjectPose = serde_json::from_slice(
@@ -78,7 +78,7 @@ fn vision_component_over_the_bus() {
     )
     .unwrap();
     let p = reply.pose.position;
-    let err = ((p[0] - 0.36).powi(2) + (p[1] + 0.25).powi(2) + (p[2] - 0.78).powi(2)).sqrt();
+    let err = ((p[0] - 0.52).powi(2) + (p[1] + 0.25).powi(2) + (p[2] - 1.10).powi(2)).sqrt();
     assert!(err < 0.005, "pose {p:?} is {:.1} mm off", err * 1e3);
     assert!(
         reply.confidence >= 0.8 && reply.symmetry.is_some(),

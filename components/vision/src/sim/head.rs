@@ -9,7 +9,8 @@
 //!
 //! How: forward kinematics of the model; [`HeadCamera::look_at`] searches the
 //! head joints' range (a grid, then a local refinement) for the configuration
-//! whose optical axis points closest to the target.
+//! whose optical axis points closest to the target, bending the waist forward
+//! when the head alone cannot look down far enough.
 
 use nalgebra::{Isometry3, Point3, Vector3};
 use tsukami_body::kinematics::FkState;
@@ -29,6 +30,9 @@ pub struct HeadCamera {
     pub yaw: JointId,
     /// Tilt joint.
     pub pitch: JointId,
+    /// The waist's forward bend, if the model has one (used when the head alone
+    /// cannot look down far enough).
+    pub waist: Option<JointId>,
     /// Intrinsics of the camera.
     pub intrinsics: Intrinsics,
 }
@@ -43,11 +47,13 @@ impl HeadCamera {
         let yaw = find("head_yaw", robot.joint_id("head_yaw"))?;
         let pitch = find("head_pitch", robot.joint_id("head_pitch"))?;
         intrinsics.validate()?;
+        let waist = robot.joint_id("waist_pitch").ok();
         Ok(HeadCamera {
             robot,
             link,
             yaw,
             pitch,
+            waist,
             intrinsics,
         })
     }
@@ -68,16 +74,43 @@ impl HeadCamera {
     }
 
     /// The rest configuration with the head turned to look at `target`
-    /// (base frame), within the head joints' limits.
+    /// (base frame), within the head joints' limits; when the head alone
+    /// leaves the target more than 5° off the optical axis, the waist bends
+    /// forward (the least that brings it within 5°, else the best).
     pub fn look_at(&self, target: &Point3<f64>) -> Vec<f64> {
         let mut q = self.robot.rest_positions();
+        let mut best = self.aim(&mut q, target);
+        if let Some(w) = self.waist {
+            let l = self.robot.joints[w].limits;
+            let rest = q[w];
+            for i in 1..=8 {
+                if best.0 < 1.0 - 5f64.to_radians().cos() {
+                    break;
+                }
+                let mut qw = self.robot.rest_positions();
+                qw[w] = (rest + (l.upper.min(1.0) - rest) * i as f64 / 8.0).min(l.upper);
+                let c = self.aim(&mut qw, target);
+                if c.0 < best.0 {
+                    best = c;
+                    q = qw;
+                }
+            }
+        }
+        q[self.yaw] = best.1;
+        q[self.pitch] = best.2;
+        q
+    }
+
+    /// The head angles (cost, yaw, pitch) pointing the optical axis closest
+    /// to `target` with the other joints as in `q`; cost is 1 − cos(angle off axis).
+    fn aim(&self, q: &mut [f64], target: &Point3<f64>) -> (f64, f64, f64) {
         let limits = |j: JointId| {
             let l = self.robot.joints[j].limits;
             (l.lower.max(-3.0), l.upper.min(3.0))
         };
         let (ylo, yhi) = limits(self.yaw);
         let (plo, phi) = limits(self.pitch);
-        let cost = |q: &mut Vec<f64>, y: f64, p: f64| {
+        let mut cost = |y: f64, p: f64| {
             q[self.yaw] = y;
             q[self.pitch] = p;
             let pose = self.pose(q);
@@ -90,7 +123,7 @@ impl HeadCamera {
             for j in 0..=24 {
                 let y = ylo + (yhi - ylo) * i as f64 / 24.0;
                 let p = plo + (phi - plo) * j as f64 / 24.0;
-                let c = cost(&mut q, y, p);
+                let c = cost(y, p);
                 if c < best.0 {
                     best = (c, y, p);
                 }
@@ -101,7 +134,7 @@ impl HeadCamera {
             let mut improved = false;
             for (dy, dp) in [(step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)] {
                 let (y, p) = ((best.1 + dy).clamp(ylo, yhi), (best.2 + dp).clamp(plo, phi));
-                let c = cost(&mut q, y, p);
+                let c = cost(y, p);
                 if c < best.0 {
                     best = (c, y, p);
                     improved = true;
@@ -111,8 +144,6 @@ impl HeadCamera {
                 step *= 0.5;
             }
         }
-        q[self.yaw] = best.1;
-        q[self.pitch] = best.2;
-        q
+        best
     }
 }
