@@ -4,6 +4,10 @@
 //! Every host here listens on `tcp/127.0.0.1:<free port>` with multicast scouting
 //! off, under a namespace of its own, so tests run in parallel without seeing each
 //! other and nothing leaves the machine.
+//!
+//! [`mocks`]: a mock vision and a mock controller for headless tests.
+
+pub mod mocks;
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -51,6 +55,7 @@ pub fn plugin_entry(role: &str, lib_name: &str) -> PluginEntryConfig {
         library: None,
         path: Some(plugin_file(lib_name)),
         config: None,
+        workers: None,
     }
 }
 

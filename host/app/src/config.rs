@@ -6,6 +6,18 @@
 //! [bus]
 //! listen = ["tcp/127.0.0.1:17447"]
 //!
+//! [models]                            # the only folders bus requests may read models from
+//! roots = ["../models", "~/.local/share/tsukami/models"]
+//!
+//! [limits]                            # all optional; defaults shown
+//! max_payload_bytes = 16777216        # largest request payload
+//! max_queue = 8                       # queued requests per plugin; more get `busy`
+//! max_call_ms = 120000                # the host cancels a call running longer
+//! max_samples = 10000                 # largest `max_samples` a plan may ask for
+//! max_urdf_bytes = 4194304            # model file size limits, checked before reading
+//! max_toml_bytes = 1048576
+//! max_mesh_bytes = 67108864
+//!
 //! [[plugin]]
 //! role = "grasp-planner"
 //! library = "tsukami_grasp_planner"   # platform prefix/extension added; or `path = "…/libx.so"`
@@ -13,7 +25,12 @@
 //! models_dir = "../models"
 //! ```
 //!
-//! Relative paths are relative to the config file. A plugin given by `library`
+//! Every plugin's config table gets the host's `model_roots` (absolute, existing
+//! roots only), `max_samples`, `max_urdf_bytes`, `max_toml_bytes` and
+//! `max_mesh_bytes` inserted, so every planner applies the same limits.
+//!
+//! Relative paths are relative to the config file; a root may start with `~/`.
+//! A plugin given by `library`
 //! name alone (no directory) is looked for beside the `tsukami` executable and in
 //! its `deps/` folder, which is where cargo puts the workspace's plugin libraries.
 //! Swapping in a third-party planner is a config change: name its library for the
@@ -39,6 +56,9 @@ pub struct HostConfig {
     /// Request limits.
     #[serde(default)]
     pub limits: Limits,
+    /// Where bus requests may read model files from.
+    #[serde(default)]
+    pub models: ModelsConfig,
     /// The plugins, one entry per role.
     #[serde(default, rename = "plugin")]
     pub plugins: Vec<PluginEntryConfig>,
@@ -47,21 +67,85 @@ pub struct HostConfig {
     pub base_dir: PathBuf,
 }
 
-/// Request limits.
+/// Request limits (see `docs/protocol.md`, "Limits", for the memory bound they give).
 #[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct Limits {
     /// Largest request payload the host passes to a plugin, bytes.
-    #[serde(default = "default_max_payload")]
     pub max_payload_bytes: usize,
+    /// Requests queued per plugin behind the running one; more are answered `busy`.
+    pub max_queue: usize,
+    /// The host raises a call's cancel flag after this many milliseconds.
+    pub max_call_ms: u64,
+    /// The largest per-candidate sample budget (`max_samples`) a plan may ask for.
+    pub max_samples: u32,
+    /// Largest URDF file a request may name, bytes.
+    pub max_urdf_bytes: u64,
+    /// Largest TOML file (grasp types, object, description), bytes.
+    pub max_toml_bytes: u64,
+    /// Largest mesh file, bytes.
+    pub max_mesh_bytes: u64,
 }
 
 impl Default for Limits {
     fn default() -> Self {
+        let files = tsukami_body::files::SizeLimits::default();
         Limits {
             max_payload_bytes: default_max_payload(),
+            max_queue: 8,
+            max_call_ms: 120_000,
+            max_samples: 10_000,
+            max_urdf_bytes: files.urdf,
+            max_toml_bytes: files.toml,
+            max_mesh_bytes: files.mesh,
         }
     }
+}
+
+impl Limits {
+    /// The file size limits, as the model readers take them.
+    pub fn file_sizes(&self) -> tsukami_body::files::SizeLimits {
+        tsukami_body::files::SizeLimits {
+            urdf: self.max_urdf_bytes,
+            toml: self.max_toml_bytes,
+            mesh: self.max_mesh_bytes,
+        }
+    }
+}
+
+/// The `[models]` table: the folders bus requests may name model files in.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelsConfig {
+    /// Root folders, searched in order (relative to the config file; `~/` allowed).
+    /// Default: the project's `models/` ([`default_models_dir`]) and the user data
+    /// folder ([`user_models_dir`]).
+    #[serde(default = "default_roots")]
+    pub roots: Vec<PathBuf>,
+}
+
+impl Default for ModelsConfig {
+    fn default() -> Self {
+        ModelsConfig {
+            roots: default_roots(),
+        }
+    }
+}
+
+fn default_roots() -> Vec<PathBuf> {
+    let mut roots = vec![default_models_dir()];
+    roots.extend(user_models_dir());
+    roots
+}
+
+/// The user's own model folder: `$XDG_DATA_HOME/tsukami/models`, else
+/// `~/.local/share/tsukami/models`.
+pub fn user_models_dir() -> Option<PathBuf> {
+    let data = std::env::var_os("XDG_DATA_HOME")
+        .filter(|d| !d.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".local/share")))?;
+    Some(data.join("tsukami").join("models"))
 }
 
 /// One plugin and the role it fills.
@@ -80,6 +164,10 @@ pub struct PluginEntryConfig {
     /// The plugin's own config, handed to it as TOML text.
     #[serde(default)]
     pub config: Option<toml::Table>,
+    /// Calls the host runs at once for this plugin (its worker pool; default
+    /// 1). Used only if the plugin declares the `concurrent` capability.
+    #[serde(default)]
+    pub workers: Option<usize>,
 }
 
 fn default_namespace() -> String {
@@ -150,9 +238,44 @@ impl HostConfig {
             namespace: namespace.to_owned(),
             bus,
             limits: Limits::default(),
+            models: ModelsConfig::default(),
             plugins: vec![],
             base_dir: PathBuf::from("."),
         }
+    }
+
+    /// The model roots as absolute, canonical folders (missing ones skipped).
+    pub fn model_roots(&self) -> Vec<PathBuf> {
+        let home = std::env::var_os("HOME").map(PathBuf::from);
+        self.models
+            .roots
+            .iter()
+            .filter_map(|root| match root.strip_prefix("~") {
+                Ok(rest) => home.as_ref().map(|h| h.join(rest)),
+                Err(_) => Some(self.base_dir.join(root)),
+            })
+            .filter_map(|root| std::fs::canonicalize(root).ok())
+            .filter(|root| root.is_dir())
+            .collect()
+    }
+
+    /// The TOML text handed to a plugin: its own table plus the host's
+    /// `model_roots`, `max_samples` and file size limits.
+    pub fn plugin_config_text(&self, entry: &PluginEntryConfig) -> String {
+        let mut table = entry.config.clone().unwrap_or_default();
+        let roots = self
+            .model_roots()
+            .iter()
+            .map(|r| toml::Value::String(r.display().to_string()))
+            .collect();
+        table.insert("model_roots".into(), toml::Value::Array(roots));
+        let limits = &self.limits;
+        let int = |v: u64| toml::Value::Integer(v.min(i64::MAX as u64) as i64);
+        table.insert("max_samples".into(), int(limits.max_samples.into()));
+        table.insert("max_urdf_bytes".into(), int(limits.max_urdf_bytes));
+        table.insert("max_toml_bytes".into(), int(limits.max_toml_bytes));
+        table.insert("max_mesh_bytes".into(), int(limits.max_mesh_bytes));
+        table.to_string()
     }
 
     /// Resolves the plugin file of an entry.

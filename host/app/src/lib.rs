@@ -21,3 +21,4 @@ pub mod demo;
 pub mod host_handle;
 pub mod scenes;
 pub mod server;
+pub mod world;

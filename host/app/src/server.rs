@@ -8,14 +8,22 @@
 //! callback, so they work while a plugin is busy: `<ns>/<role>/stop` (sets the
 //! running call's cancel flag; the plugin sees it at its next poll) and
 //! `<ns>/host/plugins`.
+//!
+//! Work is bounded: each plugin's queue holds at most `limits.max_queue` requests
+//! (more get `busy`), a queued request keeps only zenoh's own copy of its payload,
+//! and a watchdog raises a call's cancel flag once it has run `limits.max_call_ms`.
 
 use crate::config::HostConfig;
 use crate::host_handle::BusHost;
+use crate::world::WorldHub;
 use anyhow::{bail, Context, Result};
+use std::borrow::Cow;
+use std::io::Read;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, Weak};
 use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 use tsukami_msgs::host::{PluginEntry, PluginsReply, StopReply};
 use tsukami_msgs::keys::{self, KeySpace};
 use tsukami_msgs::{ErrorCode, ErrorReply};
@@ -25,30 +33,63 @@ use zenoh::bytes::Encoding;
 use zenoh::query::{Query, Queryable};
 use zenoh::Wait;
 
-/// A request queued for a plugin's worker.
+/// A request queued for a plugin's worker. The payload stays inside the query
+/// (zenoh's buffer): it is held once, and read only when the call starts.
 struct Job {
     command: String,
-    payload: Vec<u8>,
     query: Query,
 }
 
-/// What the worker is running now, so `stop` can cancel it.
+/// What the worker is running now, so `stop` and the watchdog can cancel it.
 #[derive(Default)]
 struct CurrentCall {
     command: Option<String>,
     cancel: Arc<AtomicBool>,
+    /// When the running call started.
+    started: Option<Instant>,
+    /// The watchdog raised the cancel flag (the call hit `limits.max_call_ms`).
+    timed_out: bool,
 }
 
-/// The shared side of one plugin's worker: its queue and its current call.
+/// The shared side of one plugin's workers: its queue, its current calls and,
+/// for a world-aware plugin, the world hub its `set_*` commands go to.
 struct Worker {
-    queue: mpsc::Sender<Job>,
+    queue: mpsc::SyncSender<Job>,
     current: Arc<Mutex<CurrentCall>>,
+    /// The other workers' calls (a `concurrent` plugin with several workers).
+    more: Vec<Arc<Mutex<CurrentCall>>>,
+    world: Option<Arc<WorldHub>>,
+}
+
+/// How often the watchdog looks at the running call.
+const WATCHDOG_TICK: Duration = Duration::from_millis(10);
+
+/// The per-worker limits the host enforces itself.
+#[derive(Debug, Clone, Copy)]
+struct WorkLimits {
+    max_payload_bytes: usize,
+    max_queue: usize,
+    max_call: Duration,
 }
 
 impl Worker {
     /// Sets the running call's cancel flag; answers what was running.
     fn stop(&self) -> StopReply {
-        let current = self.current.lock().unwrap_or_else(|p| p.into_inner());
+        let mut stopped = None;
+        for other in &self.more {
+            let slot = lock(other);
+            if let Some(command) = &slot.command {
+                slot.cancel.store(true, Ordering::Relaxed);
+                stopped.get_or_insert(command.clone());
+            }
+        }
+        let current = lock(&self.current);
+        if current.command.is_none() && stopped.is_some() {
+            return StopReply {
+                stopped: true,
+                command: stopped,
+            };
+        }
         match &current.command {
             Some(command) => {
                 current.cancel.store(true, Ordering::Relaxed);
@@ -74,7 +115,7 @@ pub struct RunningHost {
     workers: Vec<JoinHandle<()>>,
 }
 
-fn reply_json(query: &Query, payload: Vec<u8>) {
+pub(crate) fn reply_json(query: &Query, payload: Vec<u8>) {
     if let Err(e) = query
         .reply(query.key_expr().clone(), payload)
         .encoding(Encoding::APPLICATION_JSON)
@@ -84,7 +125,7 @@ fn reply_json(query: &Query, payload: Vec<u8>) {
     }
 }
 
-fn reply_error(query: &Query, error: ErrorReply) {
+pub(crate) fn reply_error(query: &Query, error: ErrorReply) {
     tracing::debug!("error reply on {}: {error}", query.key_expr());
     if let Err(e) = query
         .reply_err(error.to_json_bytes())
@@ -95,63 +136,184 @@ fn reply_error(query: &Query, error: ErrorReply) {
     }
 }
 
-/// Checks a request before it reaches a plugin: size and JSON syntax. An empty
-/// payload stands for `{}`.
-fn checked_payload(query: &Query, max_bytes: usize) -> Result<Vec<u8>, ErrorReply> {
-    let bytes = query
-        .payload()
-        .map(|p| p.to_bytes().into_owned())
-        .unwrap_or_default();
-    if bytes.len() > max_bytes {
+/// Checks a request before it reaches a plugin: size, JSON syntax, and a JSON
+/// object at the top (every command takes one). An empty or all-blank payload
+/// stands for `{}`. The payload is read in place, not copied.
+pub(crate) fn check_payload(query: &Query, max_bytes: usize) -> Result<(), ErrorReply> {
+    let Some(payload) = query.payload() else {
+        return Ok(());
+    };
+    if payload.len() > max_bytes {
         return Err(ErrorReply::new(
             ErrorCode::PayloadTooLarge,
             format!(
                 "payload is {} bytes; this host accepts at most {max_bytes}",
-                bytes.len()
+                payload.len()
             ),
         ));
     }
-    if bytes.iter().all(u8::is_ascii_whitespace) {
-        return Ok(b"{}".to_vec());
-    }
-    serde_json::from_slice::<serde::de::IgnoredAny>(&bytes).map_err(|e| {
+    check_json_object(std::io::BufReader::with_capacity(
+        64 * 1024,
+        payload.reader(),
+    ))
+}
+
+/// `Ok` for blank input or one JSON object; `malformed_json` for anything that is
+/// not JSON, `invalid_request` for JSON that is not an object.
+fn check_json_object(mut reader: impl Read) -> Result<(), ErrorReply> {
+    let malformed = |e: &dyn std::fmt::Display| {
         ErrorReply::new(
             ErrorCode::MalformedJson,
             format!("payload is not valid JSON: {e}"),
         )
-    })?;
-    Ok(bytes)
+    };
+    let mut first = [0u8; 1];
+    loop {
+        match reader.read(&mut first) {
+            Ok(0) => return Ok(()),
+            Ok(_) if first[0].is_ascii_whitespace() => continue,
+            Ok(_) => break,
+            Err(e) => return Err(malformed(&e)),
+        }
+    }
+    let mut json = serde_json::Deserializer::from_reader(std::io::Cursor::new(first).chain(reader));
+    serde::de::Deserialize::deserialize(&mut json)
+        .map(|_: serde::de::IgnoredAny| ())
+        .and_then(|()| json.end())
+        .map_err(|e| malformed(&e))?;
+    if first[0] != b'{' {
+        return Err(ErrorReply::new(
+            ErrorCode::InvalidRequest,
+            "the payload must be a JSON object (`{...}`); an empty payload stands for `{}`",
+        ));
+    }
+    Ok(())
+}
+
+/// The payload a plugin gets: the query's bytes (borrowed when zenoh holds them
+/// in one piece), or `{}` when blank.
+fn call_payload(query: &Query) -> Cow<'_, [u8]> {
+    match query.payload().map(|p| p.to_bytes()) {
+        Some(bytes) if !bytes.iter().all(u8::is_ascii_whitespace) => bytes,
+        _ => Cow::Borrowed(b"{}"),
+    }
+}
+
+fn lock(current: &Mutex<CurrentCall>) -> std::sync::MutexGuard<'_, CurrentCall> {
+    current.lock().unwrap_or_else(|p| p.into_inner())
 }
 
 fn worker_loop(
-    mut plugin: PluginInstance,
+    plugin: Arc<PluginInstance>,
     name: String,
-    jobs: mpsc::Receiver<Job>,
+    jobs: Arc<Mutex<mpsc::Receiver<Job>>>,
     current: Arc<Mutex<CurrentCall>>,
+    max_call: Duration,
 ) {
-    while let Ok(job) = jobs.recv() {
+    // Workers of one plugin share its queue; each takes the next job.
+    let next = || jobs.lock().unwrap_or_else(|p| p.into_inner()).recv();
+    while let Ok(job) = next() {
         let cancel = Arc::new(AtomicBool::new(false));
         {
-            let mut slot = current.lock().unwrap_or_else(|p| p.into_inner());
+            let mut slot = lock(&current);
             slot.command = Some(job.command.clone());
             slot.cancel = cancel.clone();
+            slot.started = Some(Instant::now());
+            slot.timed_out = false;
         }
-        let result = plugin.call(&job.command, &job.payload, &cancel);
-        current.lock().unwrap_or_else(|p| p.into_inner()).command = None;
+        let result = plugin.call(&job.command, &call_payload(&job.query), &cancel);
+        let timed_out = {
+            let mut slot = lock(&current);
+            slot.command = None;
+            slot.started = None;
+            slot.timed_out
+        };
         match result {
             Ok(bytes) => reply_json(&job.query, bytes),
             Err(err) => {
                 if err.code == tsukami_plugin_api::CallError::PANICKED {
                     tracing::error!(plugin = name.as_str(), "{}", err.message);
                 }
-                let mut reply = ErrorReply::new(ErrorCode::from_wire(&err.code), err.message);
+                let code = ErrorCode::from_wire(&err.code);
+                let mut reply = if timed_out && code == ErrorCode::Cancelled {
+                    ErrorReply::new(
+                        code,
+                        format!(
+                            "the call ran for the host's limit of limits.max_call_ms = {} ms and was cancelled: {}",
+                            max_call.as_millis(),
+                            err.message
+                        ),
+                    )
+                } else {
+                    ErrorReply::new(code, err.message)
+                };
                 if let Ok(details) = serde_json::from_str(&err.details_json) {
                     reply = reply.with_details(details);
+                } else if timed_out && code == ErrorCode::Cancelled {
+                    reply = reply.with_details(serde_json::json!({
+                        "limit": "max_call_ms",
+                        "max_call_ms": max_call.as_millis() as u64,
+                    }));
                 }
                 reply_error(&job.query, reply);
             }
         }
     }
+}
+
+/// Raises the running call's cancel flag once it has run `max_call`; ends when
+/// the worker and its queryable are gone.
+fn watchdog(current: Weak<Mutex<CurrentCall>>, max_call: Duration) {
+    loop {
+        std::thread::sleep(WATCHDOG_TICK);
+        let Some(current) = current.upgrade() else {
+            return;
+        };
+        let mut slot = lock(&current);
+        let overdue = slot.started.is_some_and(|t| t.elapsed() >= max_call);
+        if overdue && !slot.timed_out {
+            slot.cancel.store(true, Ordering::Relaxed);
+            slot.timed_out = true;
+        }
+    }
+}
+
+/// Opens the host's session. With the built-in bus config, zenoh's reassembly
+/// buffer is capped at twice `limits.max_payload_bytes` plus 1 MiB (zenoh's default
+/// is 1 GiB), so an oversized request cannot grow the host before it is refused; a
+/// user's zenoh config sets its own (`transport/link/rx/max_message_size`).
+fn open_session(config: &HostConfig) -> Result<zenoh::Session> {
+    if config.bus.zenoh_config.is_some() {
+        return config.bus.open();
+    }
+    let mut zenoh_config = config.bus.to_zenoh()?;
+    let cap = config.limits.max_payload_bytes.saturating_mul(2).saturating_add(1 << 20);
+    zenoh_config
+        .insert_json5("transport/link/rx/max_message_size", &cap.to_string())
+        .map_err(|e| anyhow::anyhow!("zenoh rx max_message_size: {e}"))?;
+    zenoh::open(zenoh_config)
+        .wait()
+        .map_err(|e| anyhow::anyhow!("opening the zenoh session: {e}"))
+}
+
+/// The built-in roles no configured plugin fills (the host answers their `stop`).
+fn unserved_roles(config: &HostConfig) -> Vec<&'static str> {
+    [
+        keys::ROLE_GRASP_PLANNER,
+        keys::ROLE_TRAJECTORY_PLANNER,
+        keys::ROLE_RESULT_VIEWER,
+    ]
+    .into_iter()
+    .filter(|role| config.plugins.iter().all(|p| p.role != *role))
+    .collect()
+}
+
+/// A plugin's file as `host/plugins` lists it: the file name only, never the
+/// absolute folder.
+fn listed_path(path: &std::path::Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
 }
 
 impl RunningHost {
@@ -182,7 +344,7 @@ impl RunningHost {
             libraries.push((entry, library));
         }
 
-        let session = config.bus.open()?;
+        let session = open_session(config)?;
         let mut host = RunningHost {
             session: session.clone(),
             keys: keys.clone(),
@@ -195,6 +357,7 @@ impl RunningHost {
             workers: vec![],
         };
 
+        let mut created = Vec::new();
         for (entry, library) in libraries {
             let info = library.info().clone();
             let progress_key = keys.progress(&entry.role);
@@ -204,31 +367,52 @@ impl RunningHost {
                 progress_key,
                 info.name.clone(),
             );
-            let plugin_config = entry
-                .config
-                .as_ref()
-                .map(|t| t.to_string())
-                .unwrap_or_default();
-            let instance = library.create(bus_host.into_ffi(), &plugin_config)?;
-            let (queue, jobs) = mpsc::channel();
-            let current = Arc::new(Mutex::new(CurrentCall::default()));
+            let plugin_config = config.plugin_config_text(entry);
+            let instance = Arc::new(library.create(bus_host.into_ffi(), &plugin_config)?);
+            created.push((entry, library, info, instance));
+        }
+        let world = crate::world::start(&session, &keys, config, &created, &mut host.queryables)?;
+        for (entry, library, info, instance) in created {
+            let limits = WorkLimits {
+                max_payload_bytes: config.limits.max_payload_bytes,
+                max_queue: config.limits.max_queue.max(1),
+                max_call: Duration::from_millis(config.limits.max_call_ms),
+            };
+            let (queue, jobs) = mpsc::sync_channel(limits.max_queue);
+            let jobs = Arc::new(Mutex::new(jobs));
+            let n_workers = crate::world::workers_for(entry, &info);
+            let mut slots = Vec::new();
+            for k in 0..n_workers {
+                let current = Arc::new(Mutex::new(CurrentCall::default()));
+                slots.push(current.clone());
+                let (name, jobs, plugin) = (info.name.clone(), jobs.clone(), instance.clone());
+                let watched = Arc::downgrade(&current);
+                std::thread::Builder::new()
+                    .name(format!("watchdog-{}-{k}", entry.role))
+                    .spawn(move || watchdog(watched, limits.max_call))
+                    .context("spawning a plugin watchdog thread")?;
+                host.workers.push(
+                    std::thread::Builder::new()
+                        .name(format!("plugin-{}-{k}", entry.role))
+                        .spawn(move || worker_loop(plugin, name, jobs, current, limits.max_call))
+                        .context("spawning a plugin worker thread")?,
+                );
+            }
             let worker = Worker {
                 queue,
-                current: current.clone(),
+                current: slots.remove(0),
+                more: slots,
+                world: world
+                    .as_ref()
+                    .filter(|_| info.has(tsukami_plugin_api::PluginInfo::WORLD))
+                    .cloned(),
             };
-            let name = info.name.clone();
-            host.workers.push(
-                std::thread::Builder::new()
-                    .name(format!("plugin-{}", entry.role))
-                    .spawn(move || worker_loop(instance, name, jobs, current))
-                    .context("spawning a plugin worker thread")?,
-            );
             host.queryables.push(Self::serve_role(
                 &session,
                 &keys,
                 &entry.role,
                 worker,
-                config.limits.max_payload_bytes,
+                limits,
             )?);
             tracing::info!(
                 plugin = info.name.as_str(),
@@ -242,10 +426,16 @@ impl RunningHost {
                 version: info.version,
                 roles: vec![entry.role.clone()],
                 description: info.description,
-                path: library.path().display().to_string(),
+                path: listed_path(library.path()),
+                capabilities: info.capabilities.clone(),
+                workers: n_workers,
             });
         }
 
+        for role in unserved_roles(config) {
+            host.queryables
+                .push(Self::answer_stop_without_plugin(&session, &keys, role)?);
+        }
         let listing = serde_json::to_vec(&host.plugins)?;
         let plugins_queryable = session
             .declare_queryable(keys.host_plugins())
@@ -261,7 +451,7 @@ impl RunningHost {
         keys: &KeySpace,
         role: &str,
         worker: Worker,
-        max_bytes: usize,
+        limits: WorkLimits,
     ) -> Result<Queryable<()>> {
         let wildcard = keys.role_wildcard(role);
         let role_keys = keys.clone();
@@ -281,29 +471,69 @@ impl RunningHost {
                         ),
                     );
                 };
+                if let Err(error) = check_payload(&query, limits.max_payload_bytes) {
+                    return reply_error(&query, error);
+                }
                 if command == keys::STOP {
                     let reply = worker.stop();
                     return reply_json(&query, serde_json::to_vec(&reply).unwrap_or_default());
                 }
-                match checked_payload(&query, max_bytes) {
-                    Ok(payload) => {
-                        if worker
-                            .queue
-                            .send(Job {
-                                command,
-                                payload,
-                                query,
-                            })
-                            .is_err()
-                        {
-                            tracing::error!("worker of role {role_name} has stopped");
-                        }
+                // `<ns>/planner/set_*` of a world-aware plugin: the shared world.
+                if let Some(world) = &worker.world {
+                    if keys::world::CHANGES.contains(&command.as_str()) {
+                        return world.submit(&command, query);
                     }
-                    Err(error) => reply_error(&query, error),
+                }
+                match worker.queue.try_send(Job { command, query }) {
+                    Ok(()) => {}
+                    Err(mpsc::TrySendError::Full(job)) => reply_error(
+                        &job.query,
+                        ErrorReply::new(
+                            ErrorCode::Busy,
+                            format!(
+                                "role {role_name} is busy: {} requests are queued, the host's limits.max_queue; retry later",
+                                limits.max_queue
+                            ),
+                        ),
+                    ),
+                    Err(mpsc::TrySendError::Disconnected(job)) => {
+                        tracing::error!("worker of role {role_name} has stopped");
+                        reply_error(
+                            &job.query,
+                            ErrorReply::new(
+                                ErrorCode::Internal,
+                                format!("the worker of role {role_name} has stopped"),
+                            ),
+                        );
+                    }
                 }
             })
             .wait()
             .map_err(|e| anyhow::anyhow!("declaring {wildcard}: {e}"))
+    }
+
+    /// `<ns>/<prefix>/stop` for a built-in role no plugin fills: answered with
+    /// `no_plugin` (a garbage payload still gets `malformed_json` /
+    /// `invalid_request`).
+    fn answer_stop_without_plugin(
+        session: &zenoh::Session,
+        keys: &KeySpace,
+        role: &'static str,
+    ) -> Result<Queryable<()>> {
+        let key = keys.command(role, keys::STOP);
+        session
+            .declare_queryable(&key)
+            .callback(move |query| {
+                let error = check_payload(&query, 1 << 20).err().unwrap_or_else(|| {
+                    ErrorReply::new(
+                        ErrorCode::NoPlugin,
+                        format!("no plugin fills role {role} in this host; nothing to stop"),
+                    )
+                });
+                reply_error(&query, error);
+            })
+            .wait()
+            .map_err(|e| anyhow::anyhow!("declaring {key}: {e}"))
     }
 
     /// What `<ns>/host/plugins` answers.

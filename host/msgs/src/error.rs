@@ -16,6 +16,8 @@ pub enum ErrorCode {
     InvalidValue,
     /// The payload is larger than the host accepts.
     PayloadTooLarge,
+    /// The plugin's request queue is full (`limits.max_queue`); retry later.
+    Busy,
     /// The command is not one the plugin knows.
     UnknownCommand,
     /// No loaded plugin fills the role the key addresses.
@@ -44,6 +46,7 @@ impl ErrorCode {
             ErrorCode::InvalidRequest => "invalid_request",
             ErrorCode::InvalidValue => "invalid_value",
             ErrorCode::PayloadTooLarge => "payload_too_large",
+            ErrorCode::Busy => "busy",
             ErrorCode::UnknownCommand => "unknown_command",
             ErrorCode::NoPlugin => "no_plugin",
             ErrorCode::ModelError => "model_error",

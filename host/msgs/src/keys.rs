@@ -29,6 +29,30 @@ pub mod planner {
     pub const PLAN: &str = "plan";
 }
 
+/// World commands (`<ns>/world/<command>`), answered by the host for every
+/// world-aware plugin at once (see `docs/protocol.md`, "World"). `set_robot`,
+/// `set_object`, `set_env` and `remove_env` take the planner's payloads;
+/// `<ns>/planner/set_*` stay as aliases of the same world.
+pub mod world {
+    /// The key prefix.
+    pub const PREFIX: &str = "world";
+    /// The world as the host holds it: version, robot, object, obstacles.
+    pub const GET: &str = "get";
+    /// Host → plugin: check and build a change, keep it pending.
+    pub const PREPARE: &str = "world_prepare";
+    /// Host → plugin: make the pending change of a version current.
+    pub const COMMIT: &str = "world_commit";
+    /// Host → plugin: drop the pending change of a version.
+    pub const ABORT: &str = "world_abort";
+    /// The commands that change the world.
+    pub const CHANGES: [&str; 4] = [
+        super::planner::SET_ROBOT,
+        super::planner::SET_OBJECT,
+        super::planner::SET_ENV,
+        super::planner::REMOVE_ENV,
+    ];
+}
+
 /// The command every role understands: cancel the call the role's plugin is running.
 /// The host answers it itself, so it works while the plugin is busy.
 pub const STOP: &str = "stop";
@@ -96,6 +120,11 @@ impl KeySpace {
         self.key("host/plugins")
     }
 
+    /// `<ns>/world/<command>`: the world every world-aware plugin shares.
+    pub fn world(&self, command: &str) -> String {
+        self.key(&format!("{}/{command}", world::PREFIX))
+    }
+
     /// `<ns>/vision/detect`: ask the vision component for an object's pose.
     pub fn vision_detect(&self) -> String {
         self.key("vision/detect")
@@ -155,6 +184,7 @@ mod tests {
             "tsukami/motion/plan"
         );
         assert_eq!(ks.host_plugins(), "tsukami/host/plugins");
+        assert_eq!(ks.world(planner::SET_OBJECT), "tsukami/world/set_object");
         assert_eq!(ks.vision_pose("can"), "tsukami/vision/pose/can");
         assert_eq!(ks.controller_stop(), "tsukami/controller/stop");
         assert_eq!(ks.component_info("vision"), "tsukami/vision/info");

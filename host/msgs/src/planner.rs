@@ -74,6 +74,9 @@ pub struct RobotSummary {
     pub hand_joints: Vec<String>,
     /// Names of the grasp types loaded from the configuration.
     pub grasp_types: Vec<String>,
+    /// The world version this robot belongs to (see `docs/protocol.md`, "World").
+    #[serde(default)]
+    pub world_version: u64,
 }
 
 // ---------------------------------------------------------------------------
@@ -237,6 +240,9 @@ pub struct ObjectSummary {
     pub triangles: usize,
     /// OCP boxes, one per region.
     pub regions: Vec<OcpBox>,
+    /// The world version this object belongs to.
+    #[serde(default)]
+    pub world_version: u64,
 }
 
 // ---------------------------------------------------------------------------
@@ -322,6 +328,9 @@ pub struct RemoveEnv {
 pub struct EnvSummary {
     /// Obstacle names, sorted.
     pub obstacles: Vec<String>,
+    /// The world version these obstacles belong to.
+    #[serde(default)]
+    pub world_version: u64,
 }
 
 // ---------------------------------------------------------------------------
@@ -363,9 +372,12 @@ pub struct PlanOptions {
     /// Maximum number of random samples of Algorithm 1 per candidate (default 300).
     #[serde(default = "default_max_samples")]
     pub max_samples: u32,
-    /// Wall-clock budget for the whole plan in milliseconds (default 5000).
-    #[serde(default = "default_time_budget_ms")]
-    pub time_budget_ms: u64,
+    /// Wall-clock budget for the whole plan in milliseconds. Default: none —
+    /// the plan is bounded by its sample budget (`max_samples`,
+    /// `max_candidates`) and is deterministic; a budget makes the outcome depend
+    /// on the machine's speed (`timeout` when it runs out).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_budget_ms: Option<u64>,
     /// Joints beyond the arm the planner may add when the arm alone fails.
     #[serde(default)]
     pub whole_body: WholeBody,
@@ -387,9 +399,6 @@ pub struct PlanOptions {
 fn default_max_samples() -> u32 {
     300
 }
-fn default_time_budget_ms() -> u64 {
-    5000
-}
 fn default_max_candidates() -> u32 {
     6
 }
@@ -399,7 +408,7 @@ impl Default for PlanOptions {
         Self {
             seed: 0,
             max_samples: default_max_samples(),
-            time_budget_ms: default_time_budget_ms(),
+            time_budget_ms: None,
             whole_body: WholeBody::default(),
             palm_criterion: PalmCriterion::default(),
             delta_f: None,
@@ -556,6 +565,9 @@ pub struct PlanReply {
     /// Grasp types of the nominal palm poses searched, in the order tried
     /// (ranked by the palm criterion plus the weighted eq. (3) score).
     pub candidates_tried: Vec<String>,
+    /// The world version (robot, object, obstacles) the grasp was planned on.
+    #[serde(default)]
+    pub world_version: u64,
 }
 
 // ---------------------------------------------------------------------------
@@ -638,6 +650,7 @@ mod tests {
             samples: 3,
             timing_ms: PhaseTiming::default(),
             candidates_tried: vec![],
+            world_version: 3,
         }
     }
 

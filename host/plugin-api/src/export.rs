@@ -31,7 +31,7 @@ fn panic_message(payload: &(dyn Any + Send)) -> String {
 
 impl<P: Plugin> FfiPlugin for PluginAdapter<P> {
     fn call(
-        &mut self,
+        &self,
         command: RStr<'_>,
         payload: RSlice<'_, u8>,
         cancel: &AtomicBool,

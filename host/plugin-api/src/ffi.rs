@@ -30,6 +30,8 @@ pub struct FfiPluginInfo {
     pub roles: RVec<RString>,
     /// One-line description.
     pub description: RString,
+    /// What the plugin declares it can do (`world`, `concurrent`).
+    pub capabilities: RVec<RString>,
 }
 
 /// An error returned by a plugin: a machine-readable code, a message for people and
@@ -55,14 +57,15 @@ pub struct FfiSample {
     pub payload: RVec<u8>,
 }
 
-/// The plugin object the host drives, one call at a time.
+/// The plugin object the host drives. Shared: the host may call a plugin that
+/// declares `concurrent` from several threads at once.
 #[sabi_trait]
-pub trait FfiPlugin: Send {
+pub trait FfiPlugin: Send + Sync {
     /// Runs `command` with a serialized request; returns serialized reply bytes.
     /// The host sets `cancel` from another thread to stop a running call.
     #[sabi(last_prefix_field)]
     fn call(
-        &mut self,
+        &self,
         command: RStr<'_>,
         payload: RSlice<'_, u8>,
         cancel: &AtomicBool,

@@ -34,7 +34,7 @@
 //!     fn new(_host: Host, _config: &str) -> Result<Self, String> {
 //!         Ok(Echo)
 //!     }
-//!     fn call(&mut self, command: &str, payload: &[u8], _ctx: &CallContext<'_>) -> Result<Vec<u8>, CallError> {
+//!     fn call(&self, command: &str, payload: &[u8], _ctx: &CallContext<'_>) -> Result<Vec<u8>, CallError> {
 //!         match command {
 //!             "echo" => Ok(payload.to_vec()),
 //!             other => Err(CallError::unknown_command(other)),
@@ -48,8 +48,9 @@
 //!
 //! # Lifecycle
 //! `load` (version and layout checked) → `info()` → `new(host, config)` → any number of
-//! `call`s, **one at a time** (the host owns the plugin on one worker thread and calls
-//! it with `&mut self`) → dropped when the host shuts down. Libraries are never
+//! `call`s, **one at a time** unless the plugin declares the `concurrent` capability
+//! (then the host may run as many at once as its config gives the plugin workers;
+//! `call` takes `&self` either way) → dropped when the host shuts down. Libraries are never
 //! unloaded. A panic inside `info`, `new` or `call` is caught inside the plugin's own
 //! library and returned as an error ([`CallError::PANICKED`]); the host keeps serving.
 //! A running call is cancelled by the host setting the call's cancel flag, which the

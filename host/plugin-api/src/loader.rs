@@ -173,7 +173,8 @@ impl LoadedLibrary {
     }
 }
 
-/// A created plugin, driven one call at a time.
+/// A created plugin. `Sync`: the host shares it between its workers (one
+/// unless the plugin declares `concurrent`).
 pub struct PluginInstance {
     inner: FfiPluginBox,
 }
@@ -181,7 +182,7 @@ pub struct PluginInstance {
 impl PluginInstance {
     /// Runs one command; `cancel` may be set from another thread to stop it.
     pub fn call(
-        &mut self,
+        &self,
         command: &str,
         payload: &[u8],
         cancel: &AtomicBool,

@@ -17,9 +17,29 @@ pub struct PluginInfo {
     pub roles: Vec<String>,
     /// One-line description.
     pub description: String,
+    /// What the plugin declares it can do: [`PluginInfo::WORLD`],
+    /// [`PluginInfo::CONCURRENT`].
+    pub capabilities: Vec<String>,
 }
 
 impl PluginInfo {
+    /// Capability: the plugin shares the host's world (it answers
+    /// `world_prepare`, `world_commit`, `world_abort`; see `docs/plugins.md`).
+    pub const WORLD: &'static str = "world";
+    /// Capability: the host may run several calls of the plugin at once.
+    pub const CONCURRENT: &'static str = "concurrent";
+
+    /// The same info declaring `capabilities`.
+    pub fn with_capabilities(mut self, capabilities: &[&str]) -> Self {
+        self.capabilities = capabilities.iter().map(|c| (*c).to_owned()).collect();
+        self
+    }
+
+    /// True if the plugin declares `capability`.
+    pub fn has(&self, capability: &str) -> bool {
+        self.capabilities.iter().any(|c| c == capability)
+    }
+
     /// Builds the info from plain strings.
     pub fn new(name: &str, version: &str, roles: &[&str], description: &str) -> Self {
         PluginInfo {
@@ -27,6 +47,7 @@ impl PluginInfo {
             version: version.to_owned(),
             roles: roles.iter().map(|r| (*r).to_owned()).collect(),
             description: description.to_owned(),
+            capabilities: Vec::new(),
         }
     }
 
@@ -40,6 +61,11 @@ impl PluginInfo {
                 .map(|r| RString::from(r.as_str()))
                 .collect(),
             description: self.description.as_str().into(),
+            capabilities: self
+                .capabilities
+                .iter()
+                .map(|c| RString::from(c.as_str()))
+                .collect(),
         }
     }
 
@@ -49,6 +75,7 @@ impl PluginInfo {
             version: info.version.to_string(),
             roles: info.roles.iter().map(|r| r.to_string()).collect(),
             description: info.description.to_string(),
+            capabilities: info.capabilities.iter().map(|c| c.to_string()).collect(),
         }
     }
 }
@@ -254,7 +281,11 @@ impl<'a> CallContext<'a> {
 }
 
 /// A plugin, written in plain Rust. Export it with [`crate::export_plugin!`].
-pub trait Plugin: Send + Sized + 'static {
+///
+/// `call` takes `&self`: a plugin keeps changing state behind its own lock (or
+/// atomics). The host runs one call at a time unless the plugin declares
+/// [`PluginInfo::CONCURRENT`] and the host config gives it several workers.
+pub trait Plugin: Send + Sync + Sized + 'static {
     /// Name, version, roles and description; called before `new`.
     fn info() -> PluginInfo;
 
@@ -264,7 +295,7 @@ pub trait Plugin: Send + Sized + 'static {
 
     /// Runs one command. `payload` is the request's JSON bytes; the reply is JSON bytes.
     fn call(
-        &mut self,
+        &self,
         command: &str,
         payload: &[u8],
         ctx: &CallContext<'_>,

@@ -90,7 +90,7 @@ fn stop_latency() {
             let opts = PlanOptions {
                 delta_f: Some(1e3),
                 max_samples: 1_000_000,
-                time_budget_ms: 60_000,
+                time_budget_ms: Some(60_000),
                 ..PlanOptions::default()
             };
             let r = p.plan(&opts, &cancel, &mut |_| {});

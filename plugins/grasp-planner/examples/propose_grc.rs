@@ -1,15 +1,13 @@
 //! Measures each grasp type's reference posture and proposes GRC boxes.
 //!
-//! Usage: `propose_grc [URDF [GRASP_TYPES.toml]]` (defaults: the project's
-//! humanoid and its `grasp_types.toml`). For every grasp type it sets the
+//! Usage: `propose_grc [ROBOT [GRASP_TYPES.toml]]` (defaults: the project's
+//! humanoid, `models/robots/tsukami_humanoid`, and its `grasp_types.toml`). For every grasp type it sets the
 //! reference posture, finds the tips of the contacting links in the palm frame
 //! and prints: the opening between the thumb tips and the finger tips along
 //! palm x (GRCmax's x edge: the largest object the open posture admits), the
 //! width of the finger row along palm y (GRCmin's y edge: the surface the
 //! fingers need), and the centre between them (the GRC position), next to the
 //! values in the file.
-use std::path::PathBuf;
-
 use nalgebra::Point3;
 use tsukami_body::kinematics::FkState;
 use tsukami_body::model::Geometry;
@@ -17,12 +15,13 @@ use tsukami_grasp_planner::hand::HandModel;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let urdf = PathBuf::from(
-        args.first()
-            .map(String::as_str)
-            .unwrap_or("models/robots/tsukami_humanoid/tsukami_humanoid.urdf"),
-    );
-    let hand = HandModel::load(&urdf, args.get(1).map(PathBuf::from).as_deref())?;
+    let request = tsukami_msgs::planner::SetRobot {
+        robot: args.first().cloned().unwrap_or("tsukami_humanoid".into()),
+        grasp_types: args.get(1).cloned(),
+    };
+    let models = tsukami_planner_kit::models::Models::new(["models".into(), ".".into()]);
+    let robot = tsukami_planner_kit::Robot::load(&models, &request)?;
+    let hand = HandModel::from_robot(&robot)?;
     let mut fk = FkState::new(&hand.robot);
     for (t, g) in hand.config.grasp_types.iter().enumerate() {
         let mut q = hand.robot.rest_positions();

@@ -9,27 +9,15 @@
 //! Why: resolving names once at `set_robot` keeps the planning loop free of
 //! string look-ups and turns every misspelt name into one clear error up front.
 //!
-//! How: [`HandModel::new`] takes ownership of the model and the config;
-//! [`HandModel::load`] reads both files (the config defaults to
-//! `grasp_types.toml` beside the URDF).
-
-use std::path::{Path, PathBuf};
+//! How: [`HandModel::from_robot`] takes the world's robot (the planner kit
+//! resolved the description and checked the grasp types against the model)
+//! and resolves each grasp type's contacts to ids.
 
 use tsukami_body::collision::RobotCollision;
 use tsukami_body::model::{JointId, LinkId, RobotModel};
+use tsukami_planner_kit::{KitError, Robot};
 
-use crate::grasp_type::{GraspTypeConfig, GraspTypeError};
-
-/// Errors building a [`HandModel`].
-#[derive(Debug, thiserror::Error)]
-pub enum HandError {
-    /// The robot model could not be loaded.
-    #[error("robot model: {0}")]
-    Body(#[from] tsukami_body::BodyError),
-    /// The grasp-type file is wrong.
-    #[error(transparent)]
-    GraspTypes(#[from] GraspTypeError),
-}
+use crate::grasp_type::GraspTypeConfig;
 
 /// A contact of a grasp type, resolved.
 #[derive(Debug, Clone, PartialEq)]
@@ -62,8 +50,8 @@ pub struct HandModel {
     pub collision: RobotCollision,
     /// The grasp-type file.
     pub config: GraspTypeConfig,
-    /// Where the grasp types came from.
-    pub config_path: PathBuf,
+    /// Finger closing stops when the link–object distance is under this (m).
+    pub contact_distance: f64,
     /// Palm link.
     pub palm: LinkId,
     /// Arm joints.
@@ -87,125 +75,56 @@ pub struct HandModel {
 }
 
 impl HandModel {
-    /// Loads a URDF and a grasp-type file (default: `grasp_types.toml` beside the URDF).
-    pub fn load(urdf: &Path, grasp_types: Option<&Path>) -> Result<Self, HandError> {
-        let robot = tsukami_body::urdf::load_urdf(urdf)?;
-        let cfg_path = grasp_types.map(Path::to_path_buf).unwrap_or_else(|| {
-            urdf.parent()
-                .unwrap_or(Path::new("."))
-                .join("grasp_types.toml")
-        });
-        let config = GraspTypeConfig::load(&cfg_path)?;
-        Self::new(robot, config, cfg_path)
-    }
-
-    /// Checks `config` against `robot` and resolves every name.
-    pub fn new(
-        robot: RobotModel,
-        config: GraspTypeConfig,
-        config_path: PathBuf,
-    ) -> Result<Self, HandError> {
-        config.check_against(&robot)?;
-        let collision = RobotCollision::new(&robot)?;
-        let id = |n: &str| robot.joint_id(n);
-        let h = &config.hand;
-        let palm = robot.link_id(&h.palm_link)?;
-        let arm = h
-            .arm_joints
-            .iter()
-            .map(|n| id(n))
-            .collect::<Result<Vec<_>, _>>()?;
-        let wrist = h
-            .wrist_joints
-            .iter()
-            .map(|n| id(n))
-            .collect::<Result<Vec<_>, _>>()?;
-        let waist = h
-            .waist_joints
-            .iter()
-            .map(|n| id(n))
-            .collect::<Result<Vec<_>, _>>()?;
-        let squat = h.squat_joint.as_deref().map(id).transpose()?;
-        let below = |root: LinkId| -> Vec<LinkId> {
-            let mut out = vec![root];
-            let mut k = 0;
-            while k < out.len() {
-                out.extend(robot.links[out[k]].children.iter().copied());
-                k += 1;
-            }
-            out
+    /// The paper planner's view of the world's robot (its first hand).
+    pub fn from_robot(robot: &Robot) -> Result<Self, KitError> {
+        let hand = robot.hand();
+        let model = &robot.model;
+        let id = |n: &str| {
+            model
+                .joint_id(n)
+                .map_err(|e| KitError::model("robot", e.to_string()))
         };
-        let hand_links = below(palm);
-        let hand_joints: Vec<JointId> = robot
-            .joints
-            .iter()
-            .enumerate()
-            .filter(|(_, j)| j.is_independent() && hand_links.contains(&j.child))
-            .map(|(i, _)| i)
-            .collect();
-        let first_arm_child = robot.joints[arm[0]].child;
-        let arm_links: Vec<LinkId> = below(first_arm_child)
-            .into_iter()
-            .filter(|l| !hand_links.contains(l))
-            .collect();
-        let body_links: Vec<LinkId> = (0..robot.links.len())
-            .filter(|l| {
-                !hand_links.contains(l)
-                    && !arm_links.contains(l)
-                    && !collision.link_parts(*l).is_empty()
-            })
-            .collect();
-        // Torso, head and legs move only through the waist and squat joints,
-        // whose limits are the robot's business: only pairs involving the arm
-        // or the hand are checked for self-collision.
-        let mut collision = collision;
-        for (i, &a) in body_links.iter().enumerate() {
-            for &b in &body_links[i + 1..] {
-                collision.allow(a, b);
-            }
-        }
         let mut types = Vec::new();
-        for g in &config.grasp_types {
+        for g in &hand.grasp_types.grasp_types {
             let posture = g
                 .posture
                 .iter()
                 .map(|(n, v)| Ok((id(n)?, *v)))
-                .collect::<Result<Vec<_>, tsukami_body::BodyError>>()?;
+                .collect::<Result<Vec<_>, KitError>>()?;
             let mut contacts = Vec::new();
             for c in &g.contacts {
-                let link = robot.link_id(&c.link)?;
-                let finger_joints = robot
+                let link = model
+                    .link_id(&c.link)
+                    .map_err(|e| KitError::model("robot", e.to_string()))?;
+                let finger_joints = model
                     .independent_chain(link)
                     .into_iter()
-                    .filter(|j| hand_links.contains(&robot.joints[*j].child))
+                    .filter(|j| hand.links.contains(&model.joints[*j].child))
                     .collect();
+                let perturb = c.perturb.iter().map(|n| id(n)).collect::<Result<_, _>>()?;
                 contacts.push(ResolvedContact {
                     link,
                     joint: id(&c.joint)?,
-                    perturb: c
-                        .perturb
-                        .iter()
-                        .map(|n| id(n))
-                        .collect::<Result<Vec<_>, _>>()?,
+                    perturb,
                     finger_joints,
                 });
             }
             types.push(ResolvedType { posture, contacts });
         }
         Ok(Self {
-            robot,
-            collision,
-            config,
-            config_path,
-            palm,
-            arm,
-            wrist,
-            waist,
-            squat,
-            hand_links,
-            hand_joints,
-            arm_links,
-            body_links,
+            robot: model.clone(),
+            collision: hand.collision.clone(),
+            config: hand.grasp_types.clone(),
+            contact_distance: hand.contact_distance,
+            palm: hand.palm,
+            arm: hand.arm.clone(),
+            wrist: hand.wrist.clone(),
+            waist: robot.waist.clone(),
+            squat: robot.whole_body.first().copied(),
+            hand_links: hand.links.clone(),
+            hand_joints: hand.joints.clone(),
+            arm_links: hand.arm_links.clone(),
+            body_links: hand.body_links.clone(),
             types,
         })
     }

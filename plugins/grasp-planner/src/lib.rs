@@ -7,22 +7,21 @@
 //! [`ocp`] (object boxes and free faces) → [`selection`] (eqs. (1)–(5), score
 //! (3)) → [`palm_pose`] (nominal palm pose, section 3.2) → [`search`]
 //! (Algorithm 1, with [`finger_closing`]) → [`whole_body`] (section 3.4
-//! fallback), driven by the [`planner::Planner`] state machine. The hand's
-//! reference postures come from [`grasp_type`] (a TOML file, see
-//! `docs/grasp-types.md`), resolved against the robot in [`hand`]; objects are
-//! checked and placed in [`object`]; [`scene`] turns a scene file of `models/`
-//! into planner requests. [`plugin`] is the FFI adapter (the `grasp-planner`
-//! role), exported with `tsukami-plugin-api`'s `export_plugin!`.
+//! fallback), driven by [`planner::Paper`], the planner kit's `GraspPlanner`.
+//! The hand's reference postures are the kit's grasp types ([`grasp_type`],
+//! `docs/grasp-types.md`), resolved to ids in [`hand`]; the object's OCPs are
+//! built in [`object`]. [`plugin`] exports the planner with the kit's
+//! `export_planner!`; the kit owns the world, validation, dispatch, error codes,
+//! the reply and the final verification.
 //!
-//! The algorithm does no I/O beyond loading model files through
-//! `tsukami-body`; the plugin adapter only (de)serialises messages.
+//! The algorithm does no I/O: the kit reads every model file.
 //!
 //! ```no_run
 //! use std::sync::atomic::AtomicBool;
 //! use tsukami_grasp_planner::planner::Planner;
 //! use tsukami_scenes::scene_requests;
 //! let req = scene_requests("models/scenes/can_breast.toml".as_ref()).unwrap();
-//! let mut planner = Planner::new("models");
+//! let planner = Planner::new("models");
 //! planner.set_robot(&req.robot).unwrap();
 //! planner.set_object(&req.object).unwrap();
 //! planner.set_env(&req.env).unwrap();
@@ -42,4 +41,6 @@ pub mod planner;
 pub mod plugin;
 pub mod search;
 pub mod selection;
+pub mod support;
+pub mod verify;
 pub mod whole_body;

@@ -23,9 +23,17 @@ fn tmp(name: &str) -> PathBuf {
     dir.join(name)
 }
 
+/// A planner reading models from `models/` and from this test's temp folder
+/// (the meshes it writes); nothing else is readable.
+fn planner() -> Planner {
+    let roots = [models(), tmp("x").parent().unwrap().to_path_buf()];
+    let config = tsukami_planner_kit::PlannerConfig::with_roots(roots);
+    Planner::from_config(config).unwrap()
+}
+
 fn ready() -> Planner {
     let req = scene_requests(&models().join("scenes/can_breast.toml")).unwrap();
-    let mut p = Planner::new(models());
+    let mut p = planner();
     p.set_robot(&req.robot).unwrap();
     p.set_object(&req.object).unwrap();
     p.set_env(&req.env).unwrap();
@@ -57,15 +65,27 @@ fn plan(p: &mut Planner) -> Result<tsukami_msgs::planner::PlanReply, PlanError> 
 #[test]
 fn plan_without_robot_or_object_says_so() {
     let mut p = Planner::new(models());
-    assert!(matches!(plan(&mut p), Err(PlanError::NoRobot)));
+    assert!(matches!(
+        plan(&mut p),
+        Err(PlanError::NotReady {
+            missing: "robot",
+            ..
+        })
+    ));
     p.set_robot(&SetRobot {
         robot: "tsukami_humanoid".into(),
         grasp_types: None,
     })
     .unwrap();
     let e = plan(&mut p).unwrap_err();
-    assert!(matches!(e, PlanError::NoObject));
-    assert_eq!(e.code(), "no_object");
+    assert!(matches!(
+        e,
+        PlanError::NotReady {
+            missing: "object",
+            ..
+        }
+    ));
+    assert_eq!(e.reason(), "no_object");
     assert!(e.to_string().contains("set_object"));
 }
 
@@ -84,7 +104,7 @@ fn bad_objects_are_refused_and_the_state_is_kept() {
             ..mesh_object(Path::new("x"), 0.1)
         })
         .unwrap_err();
-    assert_eq!(e.code(), "unknown_model");
+    assert_eq!(e.reason(), "bad_model");
     assert!(e.to_string().contains("no_such_thing"), "{e}");
 
     // Mass <= 0.
@@ -117,7 +137,7 @@ fn bad_objects_are_refused_and_the_state_is_kept() {
     let path = tmp("flat.obj");
     flat.write_obj(&path).unwrap();
     let e = p.set_object(&mesh_object(&path, 0.1)).unwrap_err();
-    assert_eq!(e.code(), "bad_object");
+    assert_eq!(e.reason(), "bad_model");
     assert!(e.to_string().contains("degenerate"), "{e}");
 
     // Huge: one million triangles.
@@ -227,7 +247,7 @@ fn bad_env_and_options_are_refused() {
             &mut |_| {},
         )
         .unwrap_err();
-    assert_eq!(e.code(), "bad_options");
+    assert_eq!(e.reason(), "bad_value");
 }
 
 #[test]
@@ -239,7 +259,7 @@ fn heavy_or_huge_objects_fit_no_grasp_type() {
         .unwrap();
     p.set_object(&mesh_object(&path, 5.0)).unwrap();
     let e = plan(&mut p).unwrap_err();
-    assert_eq!(e.code(), "no_grasp_type");
+    assert_eq!(e.reason(), "no_grasp_type");
     assert!(e.to_string().contains("heavier"), "{e}");
     let path = tmp("big.stl");
     TriangleMesh::cuboid(Vector3::new(0.5, 0.5, 0.5))
@@ -261,7 +281,7 @@ fn far_object_is_unreachable_even_with_squat() {
     req.pose = pose_at([2.0, -0.25, 1.0]);
     p.set_object(&req).unwrap();
     let e = plan(&mut p).unwrap_err();
-    assert_eq!(e.code(), "unreachable");
+    assert_eq!(e.reason(), "unreachable");
     assert!(e.to_string().contains("squat_z"), "{e}");
 }
 
@@ -274,7 +294,7 @@ fn cancel_stops_the_plan_and_progress_is_reported() {
     let r = p.plan(
         &PlanOptions {
             max_samples: 100_000,
-            time_budget_ms: 600_000,
+            time_budget_ms: Some(600_000),
             delta_f: Some(1000.0),
             ..PlanOptions::default()
         },
@@ -287,7 +307,10 @@ fn cancel_stops_the_plan_and_progress_is_reported() {
         },
     );
     match r {
-        Err(PlanError::Cancelled) => {}
+        Err(PlanError::NoGrasp {
+            no_grasp: tsukami_planner_kit::NoGrasp::Stopped(tsukami_planner_kit::Stop::Cancelled),
+            ..
+        }) => {}
         other => panic!("expected a cancelled plan, got {other:?}"),
     }
     assert_eq!(events.first(), Some(&PlanPhase::Selection));
@@ -305,7 +328,7 @@ fn bad_robots_are_refused_and_the_state_is_kept() {
             grasp_types: None,
         })
         .unwrap_err();
-    assert_eq!(e.code(), "unknown_model");
+    assert_eq!(e.reason(), "bad_model");
     // A grasp-type file with a misspelt key names it.
     let cfg = models().join("robots/tsukami_humanoid/grasp_types.toml");
     let text = std::fs::read_to_string(&cfg)
@@ -319,7 +342,7 @@ fn bad_robots_are_refused_and_the_state_is_kept() {
             grasp_types: Some(bad.display().to_string()),
         })
         .unwrap_err();
-    assert_eq!(e.code(), "bad_robot");
+    assert_eq!(e.reason(), "bad_model");
     assert!(e.to_string().contains("closing_stepp"), "{e}");
     // A joint name that is not in the robot.
     let text =

@@ -92,7 +92,8 @@ fn bad_input_names_the_field_and_keeps_state() {
     assert_eq!(details(&e)["field"], "pose.quaternion");
     let e = plugin.call("set_object", br#"{"shape": {"model": {"name": "teapot"}}, "mass": 0.1, "pose": {"position": [0, 0, 0]}}"#, &ctx).unwrap_err();
     assert_eq!(e.code, "model_error");
-    assert_eq!(details(&e)["name"], "teapot");
+    assert_eq!(details(&e)["field"], "shape.model.name");
+    assert!(e.message.contains("teapot"), "{e}");
     let e = plugin
         .call(
             "set_object",

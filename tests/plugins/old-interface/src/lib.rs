@@ -2,7 +2,7 @@
 //!
 //! It carries its own copy of the interface as it stood at version 0.1.0 (a root
 //! module with only `info`), exactly what a plugin compiled against that old
-//! `tsukami-plugin-api` would export. The host (interface 0.2.x) must refuse it with
+//! `tsukami-plugin-api` would export. The host (interface 0.3.x) must refuse it with
 //! a message naming the plugin and both versions.
 
 #![allow(non_local_definitions)]

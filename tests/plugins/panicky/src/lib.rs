@@ -3,11 +3,12 @@
 //! The host must turn the panic into an error reply and keep serving: `count`
 //! answers how many calls the plugin has seen, proving its state survived.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use tsukami_plugin_api::{export_plugin, CallContext, CallError, Host, Plugin, PluginInfo};
 
 /// Panics on `panic`, echoes on `echo`, counts calls on `count`.
 pub struct Panicky {
-    calls: u64,
+    calls: AtomicU64,
 }
 
 impl Plugin for Panicky {
@@ -21,20 +22,22 @@ impl Plugin for Panicky {
     }
 
     fn new(_host: Host, _config: &str) -> Result<Self, String> {
-        Ok(Panicky { calls: 0 })
+        Ok(Panicky {
+            calls: AtomicU64::new(0),
+        })
     }
 
     fn call(
-        &mut self,
+        &self,
         command: &str,
         payload: &[u8],
         _ctx: &CallContext<'_>,
     ) -> Result<Vec<u8>, CallError> {
-        self.calls += 1;
+        let calls = self.calls.fetch_add(1, Ordering::Relaxed) + 1;
         match command {
-            "panic" => panic!("asked to panic (call {})", self.calls),
+            "panic" => panic!("asked to panic (call {calls})"),
             "echo" => Ok(payload.to_vec()),
-            "count" => Ok(format!("{{\"calls\":{}}}", self.calls).into_bytes()),
+            "count" => Ok(format!("{{\"calls\":{calls}}}").into_bytes()),
             other => Err(CallError::unknown_command(other)),
         }
     }

@@ -42,7 +42,7 @@ impl Plugin for Slow {
     }
 
     fn call(
-        &mut self,
+        &self,
         command: &str,
         payload: &[u8],
         ctx: &CallContext<'_>,

@@ -1,0 +1,11 @@
+//! Building blocks a planner may call or ignore: finger closing, finger force,
+//! collision passes, whole-body IK stages, grasp-type postures and surface
+//! sampling. Each works on the kit's
+//! [`crate::Robot`] / [`crate::Hand`] and knows nothing of any planner.
+
+pub mod closing;
+pub mod collision;
+pub mod force;
+pub mod posture;
+pub mod stages;
+pub mod surface;

@@ -1,0 +1,142 @@
+//! Verification of every grasp before it leaves the kit.
+//!
+//! What: [`verify`] checks a returned [`Grasp`] on the world it was planned on:
+//! a configuration of the model's size with finite values, at least one
+//! contact, every contact finite with a unit normal and a positive force
+//! limit, on a hand link; then the exact friction-cone test
+//! (`tsukami_grasp::exact`, a second-order cone program) must find contact
+//! forces, each within its cone and the hand's single force bound (the weakest
+//! finger's `f_max`, stated in the reply as `force_limit`), that resist the object's
+//! weight. [`force_closure`] is the force-closure step alone, which planners
+//! call inside their loops (the ellipsoid margin of eq. (10) and the exact
+//! verdict).
+//!
+//! Why: a planner may be new and wrong; the protocol promises that every grasp
+//! sent was verified. The checks here are the kit's, not the planner's.
+//!
+//! How: checks run in order and the first failure is the reason. **Extension
+//! point:** geometric checks (no link inside the object or an obstacle beyond a
+//! tolerance, contacts on the surface) go in [`geometric_checks`], which runs
+//! before the force-closure step.
+
+use nalgebra::Vector3;
+use tsukami_grasp::contact::Contact;
+use tsukami_grasp::ellipsoid::{ellipsoid_test, EllipsoidModel};
+use tsukami_grasp::exact::{exact_test, ConeModel};
+use tsukami_grasp::grasp::Grasp as GraspMatrix;
+
+use crate::grasp::{FingerContact, Grasp};
+use crate::object::Object;
+use crate::planner::{GraspPlanner, World};
+
+/// Gravity in the world frame (z up), m/s².
+pub const GRAVITY: Vector3<f64> = Vector3::new(0.0, 0.0, -9.81);
+
+/// The force-closure verdicts of a contact set for the object's weight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Verdict {
+    /// Ellipsoid margin `n − f(p1..pn)` of eq. (10).
+    pub margin: f64,
+    /// The exact friction-cone test resists the weight.
+    pub exact_resists_weight: bool,
+    /// The characteristic length used (γ = 1 / length in eq. (6)).
+    pub characteristic_length: f64,
+    /// The one normal-force bound applied to every contact, N: the weakest
+    /// finger's `f_max` (the paper's single maximum finger force).
+    pub force_limit: f64,
+}
+
+/// The paper's single maximum finger force of a contact set: the weakest `f_max`.
+pub fn force_limit(contacts: &[FingerContact]) -> f64 {
+    contacts
+        .iter()
+        .map(|c| c.f_max)
+        .fold(f64::INFINITY, f64::min)
+        .max(1e-6)
+}
+
+/// The ellipsoid margin and the exact verdict of `contacts` on `object` for its
+/// weight; `None` when the contacts make no valid grasp (degenerate).
+pub fn force_closure(object: &Object, contacts: &[FingerContact], length: f64) -> Option<Verdict> {
+    let cs = contacts
+        .iter()
+        .map(|c| Contact::new(c.position, c.normal).ok())
+        .collect::<Option<Vec<_>>>()?;
+    let limit = force_limit(contacts);
+    let limits = vec![limit; contacts.len()];
+    let com = object.center_of_mass;
+    let grasp = GraspMatrix::with_force_limits(cs, limits, object.mu, length, com).ok()?;
+    let weight = grasp.weight_wrench(object.mass, &GRAVITY, &com);
+    let margin = ellipsoid_test(&grasp, &EllipsoidModel::default(), &weight).margin();
+    let exact = exact_test(&grasp, ConeModel::Circular, &weight).ok()?;
+    Some(Verdict {
+        margin,
+        exact_resists_weight: exact.resists_weight(),
+        characteristic_length: length,
+        force_limit: limit,
+    })
+}
+
+fn shape_checks<P: GraspPlanner>(world: &World<'_, P>, grasp: &Grasp) -> Result<(), String> {
+    let model = &world.robot.model;
+    if grasp.q.len() != model.joints.len() || !grasp.q.iter().all(|v| v.is_finite()) {
+        return Err("the configuration is not one finite value per joint".into());
+    }
+    if grasp
+        .joints
+        .iter()
+        .chain(&grasp.extra)
+        .any(|&j| j >= model.joints.len())
+    {
+        return Err("a joint id is out of range".into());
+    }
+    if grasp.contacts.is_empty() {
+        return Err("no contacts".into());
+    }
+    let hand = world.hand();
+    for (i, c) in grasp.contacts.iter().enumerate() {
+        let finite = c
+            .position
+            .iter()
+            .chain(c.normal.iter())
+            .all(|v| v.is_finite());
+        if !finite
+            || (c.normal.norm() - 1.0).abs() > 1e-6
+            || !(c.f_max.is_finite() && c.f_max > 0.0)
+        {
+            return Err(format!(
+                "contact {i} has a non-finite value, a non-unit normal or no force"
+            ));
+        }
+        if !hand.links.contains(&c.link) {
+            return Err(format!("contact {i} is not on a hand link"));
+        }
+    }
+    Ok(())
+}
+
+/// Geometric checks of the grasp on the world (links clear of the object and
+/// the obstacles beyond a tolerance, contacts on the surface). The place for
+/// further checks; none beyond the shape checks yet.
+pub fn geometric_checks<P: GraspPlanner>(
+    _world: &World<'_, P>,
+    _grasp: &Grasp,
+) -> Result<(), String> {
+    Ok(())
+}
+
+/// Verifies `grasp` on `world` (see the module docs); the verdict or why not.
+pub fn verify<P: GraspPlanner>(world: &World<'_, P>, grasp: &Grasp) -> Result<Verdict, String> {
+    shape_checks(world, grasp)?;
+    geometric_checks(world, grasp)?;
+    let length = grasp
+        .characteristic_length
+        .filter(|l| l.is_finite() && *l > 0.0)
+        .unwrap_or_else(|| world.object.characteristic_length());
+    let verdict = force_closure(world.object, &grasp.contacts, length)
+        .ok_or("the contacts make no valid grasp matrix")?;
+    if !verdict.exact_resists_weight || !verdict.margin.is_finite() {
+        return Err("the exact friction-cone test finds no forces that resist the weight".into());
+    }
+    Ok(verdict)
+}
