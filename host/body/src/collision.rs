@@ -181,12 +181,76 @@ impl CollisionObject {
         &self.parts
     }
 
+    /// The nearest point of the object's mesh parts to the world point `p`
+    /// (`None` when the object has no mesh part or `p` is not finite).
+    pub fn surface_point(&self, p: &Point3<f64>) -> Option<SurfacePoint> {
+        use parry3d_f64::query::PointQueryWithLocation;
+        use parry3d_f64::shape::TrianglePointLocation;
+        let mut best: Option<SurfacePoint> = None;
+        for part in &self.parts {
+            let Some(mesh) = part.shape.as_trimesh() else {
+                continue;
+            };
+            let world = self.parry_pose * part.origin;
+            let local = world.inverse_transform_point(to_vec(p));
+            let (proj, (tri, loc)) = mesh.project_local_point_and_get_location(local, false);
+            let Some(n) = mesh.triangle(tri).normal() else {
+                continue;
+            };
+            let point = to_point(world.transform_point(proj.point));
+            let distance = (point - p).norm();
+            if !distance.is_finite() || best.is_some_and(|b| b.distance <= distance) {
+                continue;
+            }
+            best = Some(SurfacePoint {
+                point,
+                distance,
+                normal: to_vector(world.rotation * n).normalize(),
+                on_face: matches!(loc, TrianglePointLocation::OnFace(..)),
+            });
+        }
+        best
+    }
+
+    /// Do the two objects come closer than `margin` (or overlap, or one lie
+    /// inside the other's closed mesh)?
+    pub fn intersects(&self, other: &CollisionObject, margin: f64) -> bool {
+        self.parts.iter().any(|a| {
+            other.parts.iter().any(|b| {
+                pair_collides(
+                    DistanceMethod::Parry,
+                    &self.parry_pose,
+                    a,
+                    &other.parry_pose,
+                    b,
+                    margin,
+                )
+            })
+        })
+    }
+
     /// True when every part is a solid (a primitive or a closed mesh).
     pub fn is_solid(&self) -> bool {
         self.parts
             .iter()
             .all(|p| p.solid_mesh || p.shape.as_trimesh().is_none())
     }
+}
+
+/// The nearest point of an object's mesh surface to a query point, found by
+/// [`CollisionObject::surface_point`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    /// The point on the surface (world frame).
+    pub point: Point3<f64>,
+    /// Its distance from the query point (m).
+    pub distance: f64,
+    /// The unit normal of the triangle it lies on (world frame), as the
+    /// triangle is wound (outward for a closed, consistently wound mesh).
+    pub normal: Vector3<f64>,
+    /// True when the point lies inside the triangle, not on an edge or vertex
+    /// (where the surface normal is a cone, not one direction).
+    pub on_face: bool,
 }
 
 /// Closest points between a link and an object.

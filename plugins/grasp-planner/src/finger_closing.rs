@@ -1,25 +1,31 @@
 //! Finger closing (section 3.5): turn each contacting link's joint by a fixed
-//! step until the link is within a distance threshold of the object.
+//! step until the finger is within a distance threshold of the object.
 //!
 //! What: [`close_fingers`] closes the contacts of one grasp type in turn and
-//! returns, per contact, the contact point on the object, the inward normal
-//! and the largest force the finger can press with there.
+//! returns, per contact, the touching link, the contact point on the object,
+//! the inward normal and the largest force the finger can press with there.
 //!
 //! Why: this is the paper's way of finding the finger posture — cheap, and
 //! good enough because the reference posture already shapes the hand; PQP's
 //! distance, witness points and normals are parry's here (`tsukami-body`).
+//! Every link the closing joint moves stops at contact, not only the named
+//! contact link: a middle phalanx that meets the object before the fingertip
+//! stops the finger there (and is the contact), it never sinks in.
 //!
 //! How: the assigned joint moves toward its upper limit by the closing step;
-//! when the distance falls under the threshold (or the link overshoots into
-//! the object) the last step is bisected so the link ends just touching. A
+//! after each step the nearest of the links it moves ([`moved_links`]: the
+//! joint's subtree and the subtrees of joints mimicking it) is measured; when
+//! that distance falls under the threshold (or a link overshoots into the
+//! object) the last step is bisected so the finger ends just touching. A
 //! finger that reaches its joint limit without touching, or starts inside the
 //! object, fails the whole closing. The force limit is `min_j τ_max,j / |Jᵀn|`
 //! over the finger's joints (`tsukami-grasp`).
 
 use nalgebra::{DVector, Matrix3xX, Point3, Vector3};
 use tsukami_body::collision::CollisionObject;
+use tsukami_body::collision::Proximity;
 use tsukami_body::kinematics::{FkState, JointSelection};
-use tsukami_body::model::LinkId;
+use tsukami_body::model::{JointId, LinkId, RobotModel};
 use tsukami_grasp::finger_force::max_finger_force;
 
 use crate::hand::{HandModel, ResolvedContact};
@@ -30,7 +36,8 @@ pub const MAX_FINGER_FORCE: f64 = 100.0;
 /// One finger contact, world frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FingerContact {
-    /// The contacting link.
+    /// The touching link (the contact's link, or another link of the same
+    /// finger that met the object first).
     pub link: LinkId,
     /// Contact point on the object's surface.
     pub position: Point3<f64>,
@@ -62,19 +69,48 @@ pub fn close_fingers(
     Some(out)
 }
 
+/// The links, with collision geometry, that `joint` moves: its child's
+/// subtree and the subtrees of the joints that mimic it. `first` comes first.
+pub fn moved_links(hand: &HandModel, joint: JointId, first: LinkId) -> Vec<LinkId> {
+    let robot: &RobotModel = &hand.robot;
+    let mut stack: Vec<LinkId> = vec![robot.joints[joint].child];
+    for j in &robot.joints {
+        if j.mimic.as_ref().is_some_and(|m| m.master == joint) {
+            stack.push(j.child);
+        }
+    }
+    let mut out = vec![first];
+    while let Some(l) = stack.pop() {
+        if !out.contains(&l) && !hand.collision.link_parts(l).is_empty() {
+            out.push(l);
+        }
+        stack.extend(robot.links[l].children.iter().copied());
+    }
+    out.retain(|&l| !hand.collision.link_parts(l).is_empty());
+    out
+}
+
+/// The nearest of `links` to the object with the joint of `c` at `angle`.
 fn distance_at(
     hand: &HandModel,
     c: &ResolvedContact,
+    links: &[LinkId],
     q: &mut [f64],
     fk: &mut FkState,
     object: &CollisionObject,
     angle: f64,
-) -> Option<tsukami_body::collision::Proximity> {
+) -> Option<(LinkId, Proximity)> {
     q[c.joint] = angle;
     hand.robot.apply_mimics(q);
     hand.robot.forward_kinematics(q, fk);
-    hand.collision
-        .link_object_proximity(fk, c.link, object, 0.2)
+    links
+        .iter()
+        .filter_map(|&l| {
+            hand.collision
+                .link_object_proximity(fk, l, object, 0.2)
+                .map(|p| (l, p))
+        })
+        .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance))
 }
 
 fn close_one(
@@ -86,51 +122,53 @@ fn close_one(
     threshold: f64,
     step: f64,
 ) -> Option<FingerContact> {
+    let links = moved_links(hand, c.joint, c.link);
     let upper = hand.robot.joints[c.joint].limits.upper;
     let mut prev = q[c.joint];
-    let first = distance_at(hand, c, q, fk, object, prev)?;
-    if first.distance < 0.0 {
+    let first = distance_at(hand, c, &links, q, fk, object, prev)?;
+    if first.1.distance < 0.0 {
         return None; // starts inside the object
     }
-    let mut prox = first;
+    let mut near = first;
     let mut angle = prev;
     // At most one turn, even for a joint without an upper limit.
     let upper = upper.min(prev + std::f64::consts::TAU);
-    while prox.distance >= threshold {
+    while near.1.distance >= threshold {
         if angle >= upper {
             return None; // closed fully without touching
         }
         prev = angle;
         angle = (angle + step).min(upper);
-        prox = distance_at(hand, c, q, fk, object, angle)?;
+        near = distance_at(hand, c, &links, q, fk, object, angle)?;
     }
     // Overshot into the object: bisect the last step.
-    if prox.distance < 0.0 {
+    if near.1.distance < 0.0 {
         let (mut lo, mut hi) = (prev, angle);
         let mut best = None;
-        for _ in 0..12 {
+        for _ in 0..16 {
             let mid = 0.5 * (lo + hi);
-            let p = distance_at(hand, c, q, fk, object, mid)?;
-            if p.distance < 0.0 {
+            let p = distance_at(hand, c, &links, q, fk, object, mid)?;
+            if p.1.distance < 0.0 {
                 hi = mid;
             } else {
-                best = Some((mid, p));
-                if p.distance < threshold {
+                best = Some((mid, p.1.distance));
+                if p.1.distance < threshold {
                     break;
                 }
                 lo = mid;
             }
         }
-        let (a, p) = best?;
-        if p.distance >= threshold {
+        let (a, d) = best?;
+        if d >= threshold {
             return None;
         }
-        prox = distance_at(hand, c, q, fk, object, a)?;
+        near = distance_at(hand, c, &links, q, fk, object, a)?;
     }
+    let (link, prox) = near;
     let normal = -prox.normal.into_inner();
-    let f_max = finger_force(hand, c, fk, &prox.point_on_object, &normal);
+    let f_max = finger_force(hand, c, link, fk, &prox.point_on_object, &normal);
     Some(FingerContact {
-        link: c.link,
+        link,
         position: prox.point_on_object,
         normal,
         f_max,
@@ -142,6 +180,7 @@ fn close_one(
 fn finger_force(
     hand: &HandModel,
     c: &ResolvedContact,
+    link: LinkId,
     fk: &FkState,
     point: &Point3<f64>,
     normal: &Vector3<f64>,
@@ -149,8 +188,8 @@ fn finger_force(
     let Ok(sel) = JointSelection::new(&hand.robot, &c.finger_joints) else {
         return MAX_FINGER_FORCE;
     };
-    let local = fk.pose(c.link).inverse() * point;
-    let j6 = hand.robot.jacobian(fk, c.link, &local, &sel);
+    let local = fk.pose(link).inverse() * point;
+    let j6 = hand.robot.jacobian(fk, link, &local, &sel);
     let j = Matrix3xX::from_fn(sel.len(), |r, k| j6[(r, k)]);
     let efforts = DVector::from_iterator(
         sel.len(),

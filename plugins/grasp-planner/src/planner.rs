@@ -145,7 +145,10 @@ impl GraspPlanner for Paper {
         run.phase(PlanPhase::Selection, None, &[]);
         // Eqs. (1)–(5), score (3).
         let types: Vec<_> = enabled.iter().map(|&i| all[i].clone()).collect();
-        let mut selection = select(&types, &object.ocps, object.mass);
+        // Faces resting on a support or blocked by an obstacle are not sampled.
+        let mut ocps = object.ocps.clone();
+        crate::support::block_faces(&mut ocps, &w.obstacles, &Default::default());
+        let mut selection = select(&types, &ocps, object.mass);
         for c in &mut selection.candidates {
             c.grasp_type = enabled[c.grasp_type];
         }

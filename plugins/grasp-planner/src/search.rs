@@ -23,6 +23,7 @@
 //! cancel flag and the deadline are checked before every sample (a sample
 //! takes well under a millisecond).
 
+use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -41,6 +42,7 @@ use tsukami_grasp::grasp::Grasp;
 use crate::finger_closing::{close_fingers, FingerContact};
 use crate::hand::HandModel;
 use crate::object::PlanObject;
+use crate::verify::{check_grasp, PENETRATION_TOLERANCE};
 use crate::whole_body::{Stage, StageJoints};
 
 /// Gravity (world frame, m/s²).
@@ -125,6 +127,16 @@ pub enum Outcome {
     OutOfTime,
 }
 
+/// The reasons a sample is rejected, in the order of [`Counters::rejections`].
+pub const REJECTION_REASONS: [&str; 6] = [
+    "ik",
+    "collision before closing",
+    "finger closing",
+    "collision after closing",
+    "force closure",
+    "verification",
+];
+
 /// Running counters shared across searches of one plan.
 #[derive(Debug, Clone, Default)]
 pub struct Counters {
@@ -132,8 +144,35 @@ pub struct Counters {
     pub samples: u32,
     /// Best ellipsoid margin seen.
     pub best_margin: Option<f64>,
-    /// Why samples were rejected: IK, collision before closing, closing, collision after, force closure.
-    pub rejections: [u32; 5],
+    /// Why samples were rejected, per [`REJECTION_REASONS`].
+    pub rejections: [u32; 6],
+    /// What blocked the collision-rejected samples: `"<link> vs <obstacle>"`
+    /// (or `"… vs <link>"` for self-collision) with counts.
+    pub blockers: BTreeMap<String, u32>,
+}
+
+impl Counters {
+    fn reject(&mut self, reason: usize, blocker: Option<String>) {
+        self.rejections[reason] += 1;
+        if let Some(b) = blocker {
+            *self.blockers.entry(b).or_default() += 1;
+        }
+    }
+
+    /// Every non-zero rejection count: the reasons of [`REJECTION_REASONS`],
+    /// then the blockers as `"blocked: <link> vs <obstacle>"`, most frequent first.
+    pub fn reasons(&self) -> Vec<(String, u32)> {
+        let mut out: Vec<(String, u32)> = REJECTION_REASONS
+            .iter()
+            .zip(self.rejections)
+            .filter(|(_, n)| *n > 0)
+            .map(|(r, n)| (r.to_string(), n))
+            .collect();
+        let mut b: Vec<_> = self.blockers.iter().collect();
+        b.sort_by(|x, y| y.1.cmp(x.1).then(x.0.cmp(y.0)));
+        out.extend(b.into_iter().map(|(k, n)| (format!("blocked: {k}"), *n)));
+        out
+    }
 }
 
 /// Algorithm 1 around one nominal pose. `q_nominal` is the nominal IK solution
@@ -188,18 +227,7 @@ pub fn search(
         .chain(g.touch_allowed.iter())
         .filter_map(|n| robot.link_id(n).ok())
         .collect();
-    let moving: Vec<LinkId> = hand
-        .arm_links
-        .iter()
-        .chain(hand.hand_links.iter())
-        .copied()
-        .filter(|&l| !hand.collision.link_parts(l).is_empty())
-        .collect();
-    let not_touching: Vec<LinkId> = moving
-        .iter()
-        .copied()
-        .filter(|l| !contact_links.contains(l) && !allowed.contains(l))
-        .collect();
+    let links = LinkSets::new(hand, &contact_links, &allowed);
     let object = &ctx.object.collision;
     let mut fk = FkState::new(robot);
     let mut q = q_nominal.to_vec();
@@ -243,7 +271,7 @@ pub fn search(
             _ => ik.solve(&palm, true, &q, Some(q_nominal)),
         };
         if !sol.ok {
-            counters.rejections[0] += 1;
+            counters.reject(0, None);
             continue;
         }
         q.copy_from_slice(&sol.q);
@@ -260,16 +288,8 @@ pub fn search(
             robot.apply_mimics(&mut q);
         }
         robot.forward_kinematics(&q, &mut fk);
-        if hand
-            .collision
-            .first_collision(&fk, &moving, ctx.env, 0.0)
-            .is_some()
-            || hand
-                .collision
-                .first_collision(&fk, &not_touching, &[object], 0.0)
-                .is_some()
-        {
-            counters.rejections[1] += 1;
+        if let Some(why) = links.blocked(hand, &fk, object, ctx.env, false) {
+            counters.reject(1, Some(why));
             continue;
         }
         let Some(contacts) = close_fingers(
@@ -281,31 +301,22 @@ pub fn search(
             p.contact_distance,
             g.closing_step,
         ) else {
-            counters.rejections[2] += 1;
+            counters.reject(2, None);
             continue;
         };
-        if hand
-            .collision
-            .first_collision(&fk, &moving, ctx.env, 0.0)
-            .is_some()
-            || hand
-                .collision
-                .first_collision(&fk, &not_touching, &[object], 0.0)
-                .is_some()
-            || hand.collision.first_self_collision(&fk, 0.0).is_some()
-        {
-            counters.rejections[3] += 1;
+        if let Some(why) = links.blocked(hand, &fk, object, ctx.env, true) {
+            counters.reject(3, Some(why));
             continue;
         }
         let Some((margin, grasp)) = ellipsoid_margin(ctx.object, &contacts) else {
-            counters.rejections[4] += 1;
+            counters.reject(4, None);
             continue;
         };
         if counters.best_margin.is_none_or(|b| margin > b) {
             counters.best_margin = Some(margin);
         }
         if margin < p.delta_f {
-            counters.rejections[4] += 1;
+            counters.reject(4, None);
             continue;
         }
         // Confirm with the exact friction cones before answering.
@@ -313,7 +324,12 @@ pub fn search(
         let exact = exact_resists(ctx.object, &grasp);
         exact_ms += t_exact.elapsed().as_secs_f64() * 1e3;
         if !exact {
-            counters.rejections[4] += 1;
+            counters.reject(4, None);
+            continue;
+        }
+        // The guarantees of a returned grasp, on the final posture.
+        if let Err(r) = check_grasp(hand, &fk, &links.moving, object, ctx.env, &contacts) {
+            counters.reject(5, Some(r.label(hand)));
             continue;
         }
         progress(counters);
@@ -327,6 +343,73 @@ pub fn search(
         }));
     }
     Outcome::Exhausted
+}
+
+/// The robot's links with geometry, split by what they may do to the object.
+struct LinkSets {
+    /// Every arm and hand link: none may touch an obstacle.
+    moving: Vec<LinkId>,
+    /// Contact and `touch_allowed` links: may touch the object, sink in at
+    /// most half the verification tolerance.
+    touching: Vec<LinkId>,
+    /// The rest: may not touch the object.
+    not_touching: Vec<LinkId>,
+}
+
+impl LinkSets {
+    fn new(hand: &HandModel, contact_links: &[LinkId], allowed: &[LinkId]) -> Self {
+        let moving: Vec<LinkId> = hand
+            .arm_links
+            .iter()
+            .chain(hand.hand_links.iter())
+            .copied()
+            .filter(|&l| !hand.collision.link_parts(l).is_empty())
+            .fold(Vec::new(), |mut v, l| {
+                if !v.contains(&l) {
+                    v.push(l);
+                }
+                v
+            });
+        let (touching, not_touching) = moving
+            .iter()
+            .partition(|l| contact_links.contains(l) || allowed.contains(l));
+        Self {
+            moving,
+            touching,
+            not_touching,
+        }
+    }
+
+    /// What blocks the posture in `fk`, as `"<link> vs <what>"`: a link
+    /// touching an obstacle, a link that may not touch the object touching
+    /// it, a touching link sinking into it, or (`self_check`) two links.
+    fn blocked(
+        &self,
+        hand: &HandModel,
+        fk: &FkState,
+        object: &CollisionObject,
+        env: &[&CollisionObject],
+        self_check: bool,
+    ) -> Option<String> {
+        let c = &hand.collision;
+        let name = |l: LinkId| hand.robot.links[l].name.as_str();
+        if let Some(h) = c.first_collision(fk, &self.moving, env, 0.0) {
+            return Some(format!("{} vs {}", name(h.link), env[h.object].name));
+        }
+        if let Some(h) = c.first_collision(fk, &self.not_touching, &[object], 0.0) {
+            return Some(format!("{} vs the object", name(h.link)));
+        }
+        let tol = 0.5 * PENETRATION_TOLERANCE;
+        if let Some(p) = c.first_penetration(fk, &self.touching, &[object], tol) {
+            return Some(format!("{} into the object", name(p.link)));
+        }
+        if self_check {
+            if let Some((a, b)) = c.first_self_collision(fk, 0.0) {
+                return Some(format!("{} vs {}", name(a), name(b)));
+            }
+        }
+        None
+    }
 }
 
 /// The grasp of `contacts` on `object` (torques about the centre of mass).
