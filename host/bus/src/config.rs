@@ -27,6 +27,9 @@ use std::path::PathBuf;
 /// The loopback port the default host config listens on (see the README).
 pub const DEFAULT_PORT: u16 = 17447;
 
+/// The loopback port `tsukami router` listens on by default (zenoh's usual router port).
+pub const DEFAULT_ROUTER_PORT: u16 = 7447;
+
 /// The loopback endpoint of the default host.
 pub fn default_endpoint() -> String {
     format!("tcp/127.0.0.1:{DEFAULT_PORT}")
@@ -109,6 +112,17 @@ impl BusConfig {
             connect: vec![endpoint.to_owned()],
             zenoh_config: None,
             mode: BusMode::Peer,
+        }
+    }
+
+    /// A zenoh router listening on `endpoint`: the processes connect to it (in
+    /// `client` mode) instead of to each other.
+    pub fn router(endpoint: &str) -> Self {
+        BusConfig {
+            listen: vec![endpoint.to_owned()],
+            connect: vec![],
+            zenoh_config: None,
+            mode: BusMode::Router,
         }
     }
 

@@ -26,6 +26,7 @@ pub use client::{BusClient, RequestError};
 pub use component::{Component, ComponentArgs};
 pub use config::{
     check_loopback, default_endpoint, free_loopback_port, BusConfig, BusMode, DEFAULT_PORT,
+    DEFAULT_ROUTER_PORT,
 };
 pub use logging::init_logging;
 pub use shutdown::Shutdown;

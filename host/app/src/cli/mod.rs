@@ -112,6 +112,13 @@ enum Command {
     Plan(Payload),
     /// Stop: cancel the planner's running call.
     Stop,
+    /// Run a zenoh router on loopback until interrupted: the host, the components and
+    /// the clients connect to it (`mode: "client"`) instead of to each other.
+    Router {
+        /// Endpoint to listen on (loopback only without --zenoh-config).
+        #[arg(long, default_value_t = format!("tcp/127.0.0.1:{}", tsukami_bus::DEFAULT_ROUTER_PORT))]
+        listen: String,
+    },
     /// Write the JSON Schema of every bus payload.
     Schema {
         /// Output folder.
@@ -166,6 +173,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::RemoveEnv(p) => planner(keys::planner::REMOVE_ENV, p),
         Command::Plan(p) => planner(keys::planner::PLAN, p),
         Command::Stop => send(&cli.bus, ROLE_GRASP_PLANNER, keys::STOP, b""),
+        Command::Router { listen } => route(listen, &cli.bus),
         Command::Schema { out } => write_schema(out),
         Command::Demo(args) => tsukami::demo::run(args),
         Command::Model { command } => model::run(command).map(|()| ExitCode::SUCCESS),
@@ -205,6 +213,21 @@ fn serve(config: Option<&std::path::Path>, listen: &[String], bus: &BusArgs) -> 
     loop {
         std::thread::park();
     }
+}
+
+fn route(listen: &str, bus: &BusArgs) -> Result<ExitCode> {
+    let mut config = BusConfig::router(listen);
+    config.zenoh_config = bus.zenoh_config.clone();
+    let shutdown = tsukami_bus::Shutdown::on_signals()?;
+    let session = config.open()?;
+    eprintln!("tsukami: zenoh router on {listen}; Ctrl-C to stop");
+    shutdown.wait();
+    use zenoh::Wait;
+    session
+        .close()
+        .wait()
+        .map_err(|e| anyhow::anyhow!("closing the router: {e}"))?;
+    Ok(ExitCode::SUCCESS)
 }
 
 fn send(bus: &BusArgs, role: &str, command: &str, payload: &[u8]) -> Result<ExitCode> {

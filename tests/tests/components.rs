@@ -1,0 +1,471 @@
+//! The components end to end: the host (`tsukami run`) and the controller
+//! (`tsukami-controller`) as separate processes on a real zenoh bus on loopback, with
+//! a vision that answers the can's pose (the in-process mock of `tsukami_e2e::mocks`):
+//! vision finds the can, the planner plans, the grasp posture goes to the controller
+//! as a two-point trajectory, the controller's published state ends at the grasp;
+//! killing the controller mid-run makes the execute request fail with a timeout
+//! error; a restarted controller serves again. Once peer to peer, once with every
+//! process connected through a zenoh router (`tsukami router`).
+//!
+//! A mock-only variant (in-process host, mock vision, mock controller) is the
+//! headless planner test: it checks what the planner would send to the robot.
+
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+use tsukami::bus::{free_loopback_port, BusConfig};
+use tsukami::client::{BusClient, RequestError};
+use tsukami_bus::ComponentArgs;
+use tsukami_e2e::mocks::{MockController, MockVision};
+use tsukami_e2e::{
+    models_dir, planner_entry, plugin_file, spawn_tsukami, test_config, tsukami_exe, ChildGuard,
+    TestBus,
+};
+use tsukami_msgs::controller::{ControllerState, ExecuteReply, ExecutionOutcome};
+use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER};
+use tsukami_msgs::motion::{JointTrajectory, TrajectoryPoint};
+use tsukami_msgs::vision::ObjectPose;
+use tsukami_scenes::{scene_requests, SceneRequests};
+
+const T: Duration = Duration::from_secs(60);
+/// How much faster than real time the controller runs in these tests.
+const SPEED: &str = "20";
+
+/// How the processes of one test meet.
+struct Topology {
+    namespace: String,
+    /// Extra arguments of `tsukami run`.
+    host_args: Vec<String>,
+    /// Bus arguments of `tsukami-controller`.
+    controller_args: Vec<String>,
+    vision: ComponentArgs,
+    client: BusConfig,
+    _router: Option<ChildGuard>,
+    dir: PathBuf,
+}
+
+fn endpoint(port: u16) -> String {
+    format!("tcp/127.0.0.1:{port}")
+}
+
+fn scratch_dir(tag: &str, port: u16) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tsukami-{tag}-{port}"));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Peer to peer: the host, the controller and the vision each listen on a port of
+/// their own; the components connect to the host, the client to all three.
+fn peer_to_peer() -> Topology {
+    let (host, controller, vision) = (
+        endpoint(free_loopback_port().unwrap()),
+        endpoint(free_loopback_port().unwrap()),
+        endpoint(free_loopback_port().unwrap()),
+    );
+    let port = free_loopback_port().unwrap();
+    let namespace = format!("p2p-{port}");
+    Topology {
+        host_args: vec!["--listen".into(), host.clone()],
+        controller_args: ["--listen", &controller, "--connect", &host]
+            .map(String::from)
+            .to_vec(),
+        vision: ComponentArgs {
+            listen: vec![vision.clone()],
+            ..ComponentArgs::connecting(&namespace, &host)
+        },
+        client: BusConfig {
+            connect: vec![host, controller, vision],
+            ..BusConfig::connecting("tcp/127.0.0.1:1")
+        },
+        namespace,
+        _router: None,
+        dir: scratch_dir("p2p", port),
+    }
+}
+
+/// Through a router: `tsukami router` on loopback, every process a zenoh client of
+/// it, configured by a zenoh json5 file (as on two machines, see docs/components.md).
+fn through_router() -> Topology {
+    let port = free_loopback_port().unwrap();
+    let router = spawn_tsukami(&["router", "--listen", &endpoint(port)]);
+    let dir = scratch_dir("router", port);
+    let config = dir.join("client.json5");
+    std::fs::write(
+        &config,
+        format!(
+            "{{\n  mode: \"client\",\n  connect: {{ endpoints: [\"{}\"] }},\n  scouting: {{ multicast: {{ enabled: false }}, gossip: {{ enabled: false }} }},\n}}\n",
+            endpoint(port)
+        ),
+    )
+    .unwrap();
+    let client = BusConfig {
+        zenoh_config: Some(config.clone()),
+        ..BusConfig::connecting("tcp/127.0.0.1:1")
+    };
+    wait_for_router(&client);
+    let namespace = format!("router-{port}");
+    let file = config.display().to_string();
+    Topology {
+        host_args: vec!["--zenoh-config".into(), file.clone()],
+        controller_args: vec!["--zenoh-config".into(), file],
+        vision: ComponentArgs {
+            zenoh_config: Some(config),
+            ..ComponentArgs::connecting(&namespace, "tcp/127.0.0.1:1")
+        },
+        client,
+        namespace,
+        _router: Some(router),
+        dir,
+    }
+}
+
+/// A zenoh client cannot open its session before the router listens: retry.
+fn wait_for_router(client: &BusConfig) {
+    let start = Instant::now();
+    while client.open().map(|s| drop(s)).is_err() {
+        assert!(start.elapsed() < T, "the router never came up");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// The `tsukami-controller` binary of this build (built when a narrower cargo
+/// command did not build it).
+fn controller_exe() -> PathBuf {
+    let name = format!("tsukami-controller{}", std::env::consts::EXE_SUFFIX);
+    let dir = tsukami_exe().parent().unwrap().to_owned();
+    if !dir.join(&name).is_file() {
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+        let status = Command::new(cargo)
+            .args(["build", "-p", "tsukami-controller"])
+            .status()
+            .expect("running cargo build");
+        assert!(status.success(), "cargo build -p tsukami-controller failed");
+    }
+    dir.join(name)
+}
+
+fn spawn_controller(t: &Topology) -> ChildGuard {
+    let models = models_dir().display().to_string();
+    let mut args = vec![
+        "--namespace",
+        &t.namespace,
+        "--models-dir",
+        &models,
+        "--speed",
+        SPEED,
+    ];
+    args.extend(t.controller_args.iter().map(String::as_str));
+    ChildGuard(
+        Command::new(controller_exe())
+            .args(&args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("spawning tsukami-controller"),
+    )
+}
+
+fn spawn_host(t: &Topology) -> ChildGuard {
+    let config = t.dir.join("host.toml");
+    std::fs::write(
+        &config,
+        format!(
+            "namespace = \"{}\"\n\n[[plugin]]\nrole = \"grasp-planner\"\npath = {:?}\n[plugin.config]\nmodels_dir = {:?}\n",
+            t.namespace,
+            plugin_file("tsukami_grasp_planner"),
+            models_dir()
+        ),
+    )
+    .unwrap();
+    let mut args = vec![
+        "run",
+        "--config",
+        config.to_str().unwrap(),
+        "--namespace",
+        &t.namespace,
+    ];
+    args.extend(t.host_args.iter().map(String::as_str));
+    spawn_tsukami(&args)
+}
+
+fn can_scene() -> SceneRequests {
+    scene_requests(&models_dir().join("scenes/can_breast.toml")).unwrap()
+}
+
+fn json(reply: Result<Vec<u8>, RequestError>) -> serde_json::Value {
+    serde_json::from_slice(&reply.expect("a reply")).expect("reply is JSON")
+}
+
+/// Vision → SetObject → Plan: the planned joint positions.
+fn detect_and_plan(
+    client: &BusClient,
+    scene: &SceneRequests,
+) -> serde_json::Map<String, serde_json::Value> {
+    let keys = client.keys();
+    let detected: ObjectPose = serde_json::from_value(json(client.request_key(
+        &keys.vision_detect(),
+        br#"{"object": "can_350ml"}"#,
+        T,
+    )))
+    .unwrap();
+    let send = |command: &str, payload: &serde_json::Value| {
+        json(client.command(
+            ROLE_GRASP_PLANNER,
+            command,
+            payload.to_string().as_bytes(),
+            T,
+        ))
+    };
+    send(
+        planner::SET_ROBOT,
+        &serde_json::to_value(&scene.robot).unwrap(),
+    );
+    let mut object = serde_json::to_value(&scene.object).unwrap();
+    object["pose"] = serde_json::to_value(detected.pose).unwrap();
+    send(planner::SET_OBJECT, &object);
+    send(planner::SET_ENV, &serde_json::to_value(&scene.env).unwrap());
+    let plan = send(planner::PLAN, &serde_json::json!({"seed": 1}));
+    plan["joint_positions"]
+        .as_object()
+        .expect("joint_positions")
+        .clone()
+}
+
+/// From the controller's current state to `goal` (its joints the controller
+/// drives), slow enough for every joint (at most 0.25 rad/s or m/s).
+fn two_points(
+    state: &ControllerState,
+    goal: &serde_json::Map<String, serde_json::Value>,
+    min_time: f64,
+) -> JointTrajectory {
+    let mut names = Vec::new();
+    let (mut start, mut end) = (Vec::new(), Vec::new());
+    for (name, value) in goal {
+        if let Some(i) = state.joint_names.iter().position(|n| n == name) {
+            names.push(name.clone());
+            start.push(state.positions[i]);
+            end.push(value.as_f64().unwrap());
+        }
+    }
+    let widest = start
+        .iter()
+        .zip(&end)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    let time = (widest / 0.25).max(min_time);
+    let point = |time: f64, positions: Vec<f64>| TrajectoryPoint {
+        time,
+        positions,
+        velocities: vec![],
+        phase: String::new(),
+    };
+    JointTrajectory {
+        joint_names: names,
+        points: vec![point(0.0, start), point(time, end)],
+    }
+}
+
+fn current_state(client: &BusClient) -> ControllerState {
+    let bytes = client
+        .wait_for(&client.keys().controller_state(), T)
+        .expect("the controller answers its state");
+    serde_json::from_slice(&bytes).unwrap()
+}
+
+fn execute(
+    client: &BusClient,
+    trajectory: &JointTrajectory,
+    timeout: Duration,
+) -> Result<ExecuteReply, RequestError> {
+    let request = serde_json::json!({ "trajectory": trajectory });
+    client
+        .request_key(
+            &client.keys().controller_execute(),
+            request.to_string().as_bytes(),
+            timeout,
+        )
+        .map(|bytes| serde_json::from_slice(&bytes).unwrap())
+}
+
+/// Runs `trajectory` and checks that the reply and the last published state end at
+/// its last point.
+fn execute_to_the_end(
+    client: &BusClient,
+    states: &mpsc::Receiver<ControllerState>,
+    trajectory: &JointTrajectory,
+) {
+    let reply = execute(client, trajectory, T).unwrap();
+    assert!(reply.accepted, "{:?}", reply.reason);
+    assert_eq!(reply.outcome, Some(ExecutionOutcome::Done));
+    let goal = &trajectory.points[1].positions;
+    let end = reply.state.unwrap();
+    let last_published = loop {
+        let state = states.recv_timeout(T).expect("states are published");
+        if state.tick == end.tick {
+            break state;
+        }
+    };
+    assert_eq!(last_published.status, "done");
+    for (name, want) in trajectory.joint_names.iter().zip(goal) {
+        let i = end.joint_names.iter().position(|n| n == name).unwrap();
+        assert!((end.positions[i] - want).abs() < 1e-6, "{name}");
+        assert!((last_published.positions[i] - want).abs() < 1e-6, "{name}");
+    }
+}
+
+fn state_stream(
+    client: &BusClient,
+) -> (
+    zenoh::pubsub::Subscriber<()>,
+    mpsc::Receiver<ControllerState>,
+) {
+    let (tx, rx) = mpsc::channel();
+    let tx = std::sync::Mutex::new(tx);
+    let subscriber = zenoh::Wait::wait(
+        client
+            .session()
+            .declare_subscriber(client.keys().controller_state())
+            .callback(move |sample| {
+                if let Ok(state) = serde_json::from_slice(&sample.payload().to_bytes()) {
+                    let _ = tx.lock().unwrap().send(state);
+                }
+            }),
+    )
+    .unwrap();
+    (subscriber, rx)
+}
+
+/// The whole run over `t`.
+fn vision_plan_execute_kill_restart(t: Topology) {
+    let _host = spawn_host(&t);
+    let mut controller = spawn_controller(&t);
+    let scene = can_scene();
+    let vision = MockVision::start(&t.vision, "can_350ml", scene.object.pose).unwrap();
+    let client = BusClient::connect(&t.client, &t.namespace).unwrap();
+    client.wait_for_host(T).unwrap();
+    let info = client.wait_for_component("controller", T).unwrap();
+    assert_eq!(info.version, env!("CARGO_PKG_VERSION"));
+    client.wait_for_component("vision", T).unwrap();
+    let (_sub, states) = state_stream(&client);
+
+    let goal = detect_and_plan(&client, &scene);
+    let rest = current_state(&client);
+    let to_grasp = two_points(&rest, &goal, 1.0);
+    execute_to_the_end(&client, &states, &to_grasp);
+
+    // Kill the controller mid-run: the request fails with a timeout, it does not hang.
+    let back = two_points(&current_state(&client), &to_grasp_start(&to_grasp), 200.0);
+    let timeout = Duration::from_secs(5);
+    let started = Instant::now();
+    let failed = std::thread::scope(|s| {
+        let request = s.spawn(|| execute(&client, &back, timeout));
+        while states.recv_timeout(T).expect("states").status != "executing" {}
+        controller.0.kill().unwrap();
+        controller.0.wait().unwrap();
+        request.join().unwrap()
+    });
+    assert!(
+        matches!(failed, Err(RequestError::Timeout { .. })),
+        "{failed:?}"
+    );
+    assert!(
+        started.elapsed() < timeout + Duration::from_secs(5),
+        "{:?}",
+        started.elapsed()
+    );
+
+    // A restarted controller serves again (from its rest state: a new process).
+    let _controller = spawn_controller(&t);
+    client.wait_for_component("controller", T).unwrap();
+    let again = two_points(&current_state(&client), &goal, 1.0);
+    execute_to_the_end(&client, &states, &again);
+    vision.close();
+}
+
+/// The start of a two-point trajectory as a goal map.
+fn to_grasp_start(trajectory: &JointTrajectory) -> serde_json::Map<String, serde_json::Value> {
+    trajectory
+        .joint_names
+        .iter()
+        .zip(&trajectory.points[0].positions)
+        .map(|(n, &q)| (n.clone(), q.into()))
+        .collect()
+}
+
+#[test]
+fn vision_plan_and_controller_peer_to_peer() {
+    vision_plan_execute_kill_restart(peer_to_peer());
+}
+
+#[test]
+fn vision_plan_and_controller_through_a_router() {
+    vision_plan_execute_kill_restart(through_router());
+}
+
+#[test]
+fn headless_plan_with_mock_components() {
+    let bus = TestBus::start(test_config(vec![planner_entry()]));
+    // Peer to peer: each mock listens on a port of its own, the client connects to
+    // the host and to both.
+    let namespace = bus.client.keys().namespace().to_owned();
+    let listening = |port: u16| ComponentArgs {
+        listen: vec![endpoint(port)],
+        ..ComponentArgs::connecting(&namespace, &bus.endpoint)
+    };
+    let (vision_args, controller_args) = (
+        listening(free_loopback_port().unwrap()),
+        listening(free_loopback_port().unwrap()),
+    );
+    let scene = can_scene();
+    let vision = MockVision::start(&vision_args, "can_350ml", scene.object.pose).unwrap();
+    let controller = MockController::start(&controller_args).unwrap();
+    let client_bus = BusConfig {
+        connect: vec![
+            bus.endpoint.clone(),
+            vision_args.listen[0].clone(),
+            controller_args.listen[0].clone(),
+        ],
+        ..BusConfig::connecting("tcp/127.0.0.1:1")
+    };
+    let client = BusClient::connect(&client_bus, &namespace).unwrap();
+    client.wait_for_host(T).unwrap();
+    client.wait_for_component("vision", T).unwrap();
+    client.wait_for_component("controller", T).unwrap();
+    // The mock vision says what the real one says of an object it cannot see.
+    let missing = client
+        .request_key(
+            &client.keys().vision_detect(),
+            br#"{"object": "pet_bottle"}"#,
+            T,
+        )
+        .unwrap_err();
+    assert_eq!(missing.code(), Some(tsukami_msgs::ErrorCode::Infeasible));
+
+    let goal = detect_and_plan(&client, &scene);
+    let rest = ControllerState {
+        joint_names: goal.keys().cloned().collect(),
+        positions: vec![0.0; goal.len()],
+        status: "idle".into(),
+        time: 0.0,
+        velocities: vec![],
+        tick: 0,
+        trajectory_time: None,
+    };
+    let trajectory = two_points(&rest, &goal, 1.0);
+    let reply = execute(&client, &trajectory, T).unwrap();
+    assert_eq!(reply.outcome, Some(ExecutionOutcome::Done));
+    let received = controller.wait_for(1, T);
+    assert_eq!(received.len(), 1);
+    assert_eq!(received[0].trajectory, trajectory);
+    // The planner's grasp reaches the controller unchanged.
+    for (name, q) in trajectory
+        .joint_names
+        .iter()
+        .zip(&received[0].trajectory.points[1].positions)
+    {
+        assert_eq!(goal[name].as_f64().unwrap(), *q);
+    }
+    vision.close();
+    controller.close();
+}
