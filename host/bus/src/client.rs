@@ -108,6 +108,14 @@ impl BusClient {
             Ok(sample) => Ok(sample.payload().to_bytes().into_owned()),
             Err(err) => {
                 let bytes = err.payload().to_bytes();
+                // zenoh's own answer when a queryable it routed the query to did
+                // not reply in time.
+                if bytes.as_ref() == b"Timeout" {
+                    return Err(RequestError::Timeout {
+                        key: key.to_owned(),
+                        timeout,
+                    });
+                }
                 Err(RequestError::Reply(
                     serde_json::from_slice(&bytes).unwrap_or_else(|_| {
                         ErrorReply::new(
