@@ -191,15 +191,17 @@ fn twenty_times_the_mass_is_not_held() {
 
 #[test]
 fn hidden_squat_and_untrue_force_limit() {
-    // (Not `accepted`: whether this envelope grasp passes the 1 mm penetration
-    // check is the planner's business, issue 10; `rejected` compares with it.)
-    let (reply, world, regions) = planned("heavy_low");
-    assert!(reply.joint_positions["squat_z"] < -0.01);
-
+    // A reply that squats 2 cm and declares it (built from the fingertip grasp, so
+    // the test does not depend on the envelope search of issue 10); hiding the
+    // squat must add a HiddenJoint violation to whatever else that posture has.
+    let (planned_reply, world, regions) = planned("can_breast");
+    let mut reply = planned_reply.clone();
+    reply.joint_positions.insert("squat_z".into(), -0.02);
+    reply.joints_used.push("squat_z".into());
     let mut hidden = reply.clone();
     hidden.joints_used.retain(|j| j != "squat_z");
     rejected(
-        "heavy_low",
+        "can_breast",
         &world,
         &reply,
         &hidden,
@@ -209,26 +211,26 @@ fn hidden_squat_and_untrue_force_limit() {
     );
 
     // A limit above what the weakest finger can press with (e.g. a silent default).
-    let capability = verify(&world, &reply, &Tolerances::default())
+    let capability = verify(&world, &planned_reply, &Tolerances::default())
         .finger_capability
         .unwrap();
-    let mut strong = reply.clone();
+    let mut strong = planned_reply.clone();
     strong.force_closure.force_limit = capability * 1.5;
     rejected(
-        "heavy_low",
+        "can_breast",
         &world,
-        &reply,
+        &planned_reply,
         &strong,
         regions,
         "an overstated force limit",
         |v| matches!(v, Violation::ForceLimit { capability: Some(c), .. } if *c == capability),
     );
-    let mut missing = reply.clone();
+    let mut missing = planned_reply.clone();
     missing.force_closure.force_limit = 0.0;
     rejected(
-        "heavy_low",
+        "can_breast",
         &world,
-        &reply,
+        &planned_reply,
         &missing,
         regions,
         "no force limit",
