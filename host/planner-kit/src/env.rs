@@ -85,7 +85,17 @@ pub fn build_obstacle(
     o: &Obstacle,
     limits: &Limits,
 ) -> Result<CollisionObject, KitError> {
-    let at = |e: KitError| e.within(&format!("obstacles[{index}]"));
+    let at = |e: KitError| match e.within(&format!("obstacles[{index}]")) {
+        KitError::InvalidValue { field, message } => KitError::InvalidValue {
+            field,
+            message: format!("obstacle `{}`: {message}", o.name),
+        },
+        KitError::Model { field, message } => KitError::Model {
+            field,
+            message: format!("obstacle `{}`: {message}", o.name),
+        },
+        other => other,
+    };
     if o.name.is_empty() || o.name.len() > 128 {
         return Err(at(KitError::invalid("name", "must be 1 to 128 characters")));
     }

@@ -73,6 +73,9 @@ pub fn load_mesh(
 ) -> Result<(String, TriangleMesh), KitError> {
     let s = validate::scale(scale.unwrap_or(1.0), &format!("{field}.scale"))?;
     let file = models.mesh(path, &format!("{field}.path"))?;
+    if let Some(n) = binary_stl_triangles(file.path()).filter(|&n| n > MAX_TRIANGLES as u64) {
+        return Err(KitError::model(format!("{field}.path"), huge(n)));
+    }
     let mesh = TriangleMesh::load(file.path(), Vector3::repeat(s))
         .map_err(|e| KitError::model(format!("{field}.path"), relative_error(&file, &e)))?;
     check_triangles(&mesh, field)?;
@@ -83,15 +86,30 @@ pub fn load_mesh(
     Ok((stem, mesh))
 }
 
+fn huge(n: u64) -> String {
+    format!("mesh is huge: {n} triangles, more than the {MAX_TRIANGLES} accepted; decimate it")
+}
+
+/// The triangle count a binary STL's header states (`None` if not a binary
+/// STL); read before loading, so a huge mesh is refused without parsing it.
+fn binary_stl_triangles(path: &std::path::Path) -> Option<u64> {
+    use std::io::Read;
+    if !path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("stl"))
+    {
+        return None;
+    }
+    let mut head = [0u8; 84];
+    let mut f = std::fs::File::open(path).ok()?;
+    f.read_exact(&mut head).ok()?;
+    let n = u64::from(u32::from_le_bytes([head[80], head[81], head[82], head[83]]));
+    (f.metadata().ok()?.len() == 84 + 50 * n).then_some(n)
+}
+
 fn check_triangles(mesh: &TriangleMesh, field: &str) -> Result<(), KitError> {
     if mesh.indices.len() > MAX_TRIANGLES {
-        return Err(KitError::model(
-            field,
-            format!(
-                "mesh has {} triangles, more than the {MAX_TRIANGLES} accepted; decimate it",
-                mesh.indices.len()
-            ),
-        ));
+        return Err(KitError::model(field, huge(mesh.indices.len() as u64)));
     }
     mesh.validate().map_err(|m| KitError::model(field, m))
 }

@@ -34,7 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     eprintln!("{:.2} ms", t.elapsed().as_secs_f64() * 1e3);
     match r {
         Ok(r) => println!("{}", serde_json::to_string_pretty(&r)?),
-        Err(e) => println!("ERROR [{}] {e}", e.code()),
+        Err(e) => println!("ERROR [{}] {e}", e.reason()),
     }
     Ok(())
 }
