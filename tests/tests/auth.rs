@@ -16,7 +16,8 @@ use tsukami::server::RunningHost;
 use tsukami_e2e::planner_entry;
 use zenoh::Wait;
 
-const USERS: &str = "tsukami-host:change-me-host\noperator:change-me-operator\nintruder:intruder-pw\n";
+const USERS: &str =
+    "tsukami-host:change-me-host\noperator:change-me-operator\nintruder:intruder-pw\n";
 
 struct TempDir(PathBuf);
 impl Drop for TempDir {
@@ -55,7 +56,10 @@ fn example(name: &str, dir: &Path, port: u16) -> String {
     let text = std::fs::read_to_string(&file).unwrap();
     let tls = format!("{}/", dir.display());
     text.replace("/etc/tsukami/tls/", &tls)
-        .replace("/etc/tsukami/users.txt", &dir.join("users.txt").display().to_string())
+        .replace(
+            "/etc/tsukami/users.txt",
+            &dir.join("users.txt").display().to_string(),
+        )
         .replace("127.0.0.1:7448", &format!("127.0.0.1:{port}"))
 }
 
@@ -78,7 +82,11 @@ fn all_replies(session: &zenoh::Session, key: &str, timeout: Duration) -> Vec<St
 }
 
 /// A queryable on `key` answering `answer`.
-fn fake_server(session: &zenoh::Session, key: &str, answer: &'static str) -> zenoh::query::Queryable<()> {
+fn fake_server(
+    session: &zenoh::Session,
+    key: &str,
+    answer: &'static str,
+) -> zenoh::query::Queryable<()> {
     session
         .declare_queryable(key)
         .callback(move |q| {
@@ -117,10 +125,17 @@ fn only_named_users_reach_the_host_and_nobody_impersonates_it() {
         "usrpwd: { user: \"operator\", password: \"change-me-operator\" },",
         "",
     );
-    assert_ne!(no_auth, operator_text, "the example's credentials line changed");
+    assert_ne!(
+        no_auth, operator_text,
+        "the example's credentials line changed"
+    );
     let wrong = operator_text.replace("change-me-operator", "guess");
     let plain = operator_text.replace("tls/127.0.0.1", "tcp/127.0.0.1");
-    for (what, text) in [("no credentials", &no_auth), ("wrong password", &wrong), ("plain tcp", &plain)] {
+    for (what, text) in [
+        ("no credentials", &no_auth),
+        ("wrong password", &wrong),
+        ("plain tcp", &plain),
+    ] {
         if let Ok(session) = open(text) {
             let heard = all_replies(&session, "tsukami/host/plugins", Duration::from_secs(2));
             assert!(heard.is_empty(), "{what}: heard {heard:?}");
@@ -144,17 +159,31 @@ fn only_named_users_reach_the_host_and_nobody_impersonates_it() {
     // them: wait for the probe, so the fakes (declared before it) had their chance.
     let probe = (0..100)
         .find_map(|_| {
-            let r = all_replies(operator.session(), "tsukami/planner/probe", Duration::from_millis(200));
+            let r = all_replies(
+                operator.session(),
+                "tsukami/planner/probe",
+                Duration::from_millis(200),
+            );
             r.iter().any(|p| p.contains("probe")).then_some(r)
         })
         .expect("the host user's probe queryable is heard");
     assert!(probe.iter().all(|p| !p.contains("fake")), "{probe:?}");
 
     for _ in 0..3 {
-        let replies = all_replies(operator.session(), "tsukami/planner/plan", Duration::from_secs(3));
+        let replies = all_replies(
+            operator.session(),
+            "tsukami/planner/plan",
+            Duration::from_secs(3),
+        );
         assert!(!replies.is_empty(), "the real host answers plan");
-        assert!(replies.iter().all(|p| !p.contains("fake")), "impersonated: {replies:?}");
-        assert!(replies.iter().any(|p| p.contains("not_ready")), "{replies:?}");
+        assert!(
+            replies.iter().all(|p| !p.contains("fake")),
+            "impersonated: {replies:?}"
+        );
+        assert!(
+            replies.iter().any(|p| p.contains("not_ready")),
+            "{replies:?}"
+        );
     }
     // The intruder hears nothing from the host.
     let heard = all_replies(&intruder, "tsukami/host/plugins", Duration::from_secs(2));

@@ -33,7 +33,7 @@ fn plugins_lists_what_a_running_host_serves() {
     assert_eq!(listing["plugins"][0]["name"], "test-slow");
     assert_eq!(listing["plugins"][0]["version"], env!("CARGO_PKG_VERSION"));
 
-    // The planner role is not served by this host: the client times out and says so.
+    // The planner role is not served by this host: the host answers `no_plugin`.
     let out = std::process::Command::new(tsukami_exe())
         .args([
             "stop",
@@ -48,5 +48,5 @@ fn plugins_lists_what_a_running_host_serves() {
         .unwrap();
     assert!(!out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("no reply"), "{stderr}");
+    assert!(stderr.contains("no_plugin"), "{stderr}");
 }

@@ -71,7 +71,11 @@ fn hostile_files(root: &Path, outside: &Path) -> Vec<String> {
     assert_eq!(unsafe { libc::mkfifo(fifo.as_ptr(), 0o600) }, 0);
     let sparse = std::fs::File::create(root.join("sparse.stl")).unwrap();
     sparse.set_len(1 << 30).unwrap();
-    let deep = format!("<robot name=\"d\">{}{}</robot>", "<a>".repeat(10_000), "</a>".repeat(10_000));
+    let deep = format!(
+        "<robot name=\"d\">{}{}</robot>",
+        "<a>".repeat(10_000),
+        "</a>".repeat(10_000)
+    );
     std::fs::write(root.join("deep.urdf"), deep).unwrap();
     let mut many = String::from("<robot name=\"m\"><link name=\"l0\"/>");
     for i in 1..100_000 {
@@ -87,16 +91,35 @@ fn hostile_files(root: &Path, outside: &Path) -> Vec<String> {
     std::fs::write(root.join("nan.stl"), nan).unwrap();
     std::fs::write(root.join("bad.toml"), format!("x = \"{SECRET}\"\n[[[\n")).unwrap();
     let mut paths: Vec<String> = [
-        "zero.stl", "random.urdf", "environ.toml", "secret-link.toml", "fifo.stl",
-        "sparse.stl", "deep.urdf", "many.urdf", "nan.stl", "bad.toml",
+        "zero.stl",
+        "random.urdf",
+        "environ.toml",
+        "secret-link.toml",
+        "fifo.stl",
+        "sparse.stl",
+        "deep.urdf",
+        "many.urdf",
+        "nan.stl",
+        "bad.toml",
     ]
     .iter()
     .map(|n| root.join(n).display().to_string())
     .collect();
     // The same files named relative to their root.
     paths.extend(
-        ["zero.stl", "random.urdf", "environ.toml", "secret-link.toml", "fifo.stl", "sparse.stl",
-         "deep.urdf", "many.urdf", "nan.stl", "bad.toml"].map(String::from),
+        [
+            "zero.stl",
+            "random.urdf",
+            "environ.toml",
+            "secret-link.toml",
+            "fifo.stl",
+            "sparse.stl",
+            "deep.urdf",
+            "many.urdf",
+            "nan.stl",
+            "bad.toml",
+        ]
+        .map(String::from),
     );
     paths.extend([
         secret.display().to_string(),
@@ -117,7 +140,8 @@ fn hostile_files(root: &Path, outside: &Path) -> Vec<String> {
 
 #[test]
 fn the_host_survives_a_hostile_corpus_unchanged() {
-    let base = TempDir(std::env::temp_dir().join(format!("tsukami-hostile-{}", std::process::id())));
+    let base =
+        TempDir(std::env::temp_dir().join(format!("tsukami-hostile-{}", std::process::id())));
     let root = base.0.join("root");
     let outside = base.0.join("outside");
     let paths = hostile_files(&root, &outside);
@@ -134,7 +158,12 @@ fn the_host_survives_a_hostile_corpus_unchanged() {
     let object = serde_json::to_value(&req.object).unwrap();
     send(c, planner::SET_ROBOT, robot.to_string().as_bytes()).unwrap();
     send(c, planner::SET_OBJECT, object.to_string().as_bytes()).unwrap();
-    send(c, planner::SET_ENV, serde_json::to_string(&req.env).unwrap().as_bytes()).unwrap();
+    send(
+        c,
+        planner::SET_ENV,
+        serde_json::to_string(&req.env).unwrap().as_bytes(),
+    )
+    .unwrap();
     let plan = br#"{"seed": 1}"#;
     let parse = |s: &str| without_timing(serde_json::from_str(s).unwrap());
     let baseline = parse(&send(c, planner::PLAN, plan).expect("the baseline plan succeeds"));
@@ -150,13 +179,30 @@ fn the_host_survives_a_hostile_corpus_unchanged() {
 
     let mut cases: Vec<(String, &str, Vec<u8>)> = vec![];
     let garbage: Vec<Vec<u8>> = vec![
-        b"[]".to_vec(), b"1".to_vec(), b"\"x\"".to_vec(), b"null".to_vec(), b"{".to_vec(),
-        b"\xff\xfe".to_vec(), b"{\"a\":NaN}".to_vec(), b"{\"mass\":1e400}".to_vec(),
-        "[".repeat(100_000).into_bytes(), vec![b'{'; 50_000], vec![b' '; 1 << 21],
+        b"[]".to_vec(),
+        b"1".to_vec(),
+        b"\"x\"".to_vec(),
+        b"null".to_vec(),
+        b"{".to_vec(),
+        b"\xff\xfe".to_vec(),
+        b"{\"a\":NaN}".to_vec(),
+        b"{\"mass\":1e400}".to_vec(),
+        "[".repeat(100_000).into_bytes(),
+        vec![b'{'; 50_000],
+        vec![b' '; 1 << 21],
         format!("{{\"x\":\"{}\"}}", "a".repeat(2 << 20)).into_bytes(),
-        br#"{"unknown": 1}"#.to_vec(), br#"{"pose": {"position": [1e308, 0, 0], "quaternion": [0,0,0,1]}}"#.to_vec(),
+        br#"{"unknown": 1}"#.to_vec(),
+        br#"{"pose": {"position": [1e308, 0, 0], "quaternion": [0,0,0,1]}}"#.to_vec(),
     ];
-    for command in [planner::SET_ROBOT, planner::SET_OBJECT, planner::SET_ENV, planner::PLAN, "stop", "remove_env", "nonsense"] {
+    for command in [
+        planner::SET_ROBOT,
+        planner::SET_OBJECT,
+        planner::SET_ENV,
+        planner::PLAN,
+        "stop",
+        "remove_env",
+        "nonsense",
+    ] {
         for (i, g) in garbage.iter().enumerate() {
             cases.push((format!("{command} garbage {i}"), command, g.clone()));
         }
@@ -164,46 +210,85 @@ fn the_host_survives_a_hostile_corpus_unchanged() {
     for p in &paths {
         let mut r = robot.clone();
         r["robot"] = p.as_str().into();
-        cases.push((format!("robot {p:.60}"), planner::SET_ROBOT, r.to_string().into_bytes()));
+        cases.push((
+            format!("robot {p:.60}"),
+            planner::SET_ROBOT,
+            r.to_string().into_bytes(),
+        ));
         let mut r = robot.clone();
         r["grasp_types"] = p.as_str().into();
-        cases.push((format!("grasp_types {p:.60}"), planner::SET_ROBOT, r.to_string().into_bytes()));
+        cases.push((
+            format!("grasp_types {p:.60}"),
+            planner::SET_ROBOT,
+            r.to_string().into_bytes(),
+        ));
         let mut o = object.clone();
         o["shape"] = serde_json::json!({"mesh": {"path": p}});
-        cases.push((format!("mesh {p:.60}"), planner::SET_OBJECT, o.to_string().into_bytes()));
+        cases.push((
+            format!("mesh {p:.60}"),
+            planner::SET_OBJECT,
+            o.to_string().into_bytes(),
+        ));
         let env = serde_json::json!({"obstacles": [{"name": "o", "shape": {"mesh": {"path": p}},
             "pose": {"position": [0.5, 0, 0], "quaternion": [0, 0, 0, 1]}}]});
-        cases.push((format!("obstacle {p:.60}"), planner::SET_ENV, env.to_string().into_bytes()));
+        cases.push((
+            format!("obstacle {p:.60}"),
+            planner::SET_ENV,
+            env.to_string().into_bytes(),
+        ));
     }
-    for (field, value) in [("mass", serde_json::json!(-1.0)), ("friction", serde_json::json!(50.0)),
-        ("center_of_mass", serde_json::json!([10.0, 0, 0]))] {
+    for (field, value) in [
+        ("mass", serde_json::json!(-1.0)),
+        ("friction", serde_json::json!(50.0)),
+        ("center_of_mass", serde_json::json!([10.0, 0, 0])),
+    ] {
         let mut o = object.clone();
         o[field] = value;
-        cases.push((format!("object {field}"), planner::SET_OBJECT, o.to_string().into_bytes()));
+        cases.push((
+            format!("object {field}"),
+            planner::SET_OBJECT,
+            o.to_string().into_bytes(),
+        ));
     }
     for budget in [0u64, u64::MAX] {
-        cases.push((format!("plan samples {budget}"), planner::PLAN,
-            format!("{{\"max_samples\": {budget}}}").into_bytes()));
+        cases.push((
+            format!("plan samples {budget}"),
+            planner::PLAN,
+            format!("{{\"max_samples\": {budget}}}").into_bytes(),
+        ));
     }
     for i in 0..80 {
         cases.push((format!("stop storm {i}"), "stop", b"{}".to_vec()));
     }
     assert!(cases.len() >= 300, "{} cases", cases.len());
 
-    let absolute = [base.0.display().to_string(), models_dir().canonicalize().unwrap().display().to_string()];
+    let absolute = [
+        base.0.display().to_string(),
+        models_dir().canonicalize().unwrap().display().to_string(),
+    ];
     for (i, (name, command, payload)) in cases.iter().enumerate() {
         let start = Instant::now();
         let reply = match send(c, command, payload) {
             Ok(s) | Err(s) => s,
         };
         assert!(!reply.contains(SECRET), "{name}: secret in {reply:.300}");
-        assert!(!reply.contains("root:"), "{name}: passwd content in {reply:.300}");
+        assert!(
+            !reply.contains("root:"),
+            "{name}: passwd content in {reply:.300}"
+        );
         for a in &absolute {
             // (A path the request itself gave may be echoed back; no other.)
             let asked = String::from_utf8_lossy(payload).contains(a.as_str());
-            assert!(asked || !reply.contains(a.as_str()), "{name}: absolute folder in {reply:.300}");
+            assert!(
+                asked || !reply.contains(a.as_str()),
+                "{name}: absolute folder in {reply:.300}"
+            );
         }
-        assert!(start.elapsed() < CASE_LIMIT, "{name}: {:?}", start.elapsed());
+        assert!(
+            start.elapsed() < CASE_LIMIT,
+            "{name}: {:?}",
+            start.elapsed()
+        );
         if i % 4 == 0 || command.starts_with("set") {
             let again = parse(&match send(c, planner::PLAN, plan) {
                 Ok(s) | Err(s) => s,
@@ -217,11 +302,20 @@ fn the_host_survives_a_hostile_corpus_unchanged() {
     // reply (a grasp or `busy`), and the host still plans the same grasp.
     let replies: Vec<String> = std::thread::scope(|s| {
         let handles: Vec<_> = (0..12)
-            .map(|_| s.spawn(|| match send(c, planner::PLAN, plan) { Ok(s) | Err(s) => s }))
+            .map(|_| {
+                s.spawn(|| match send(c, planner::PLAN, plan) {
+                    Ok(s) | Err(s) => s,
+                })
+            })
             .collect();
         handles.into_iter().map(|h| h.join().unwrap()).collect()
     });
-    assert!(replies.iter().any(|r| r.contains("\"busy\"")), "the queue limit answered busy");
-    let again = parse(&match send(c, planner::PLAN, plan) { Ok(s) | Err(s) => s });
+    assert!(
+        replies.iter().any(|r| r.contains("\"busy\"")),
+        "the queue limit answered busy"
+    );
+    let again = parse(&match send(c, planner::PLAN, plan) {
+        Ok(s) | Err(s) => s,
+    });
     assert_eq!(again, baseline, "after the flood");
 }

@@ -99,7 +99,11 @@ fn bad_objects_get_clear_errors_and_the_planner_keeps_its_state() {
 
 #[test]
 fn stop_interrupts_a_plan_and_progress_is_published() {
-    let bus = TestBus::start(test_config(vec![planner_entry()]));
+    // This host allows a huge sample budget (the default cap would refuse it), so
+    // only Stop can end the plan below.
+    let mut config = test_config(vec![planner_entry()]);
+    config.limits.max_samples = 100_000_000;
+    let bus = TestBus::start(config);
     let c = &bus.client;
     set_up_can(c);
     let progress = c

@@ -92,7 +92,11 @@ fn main() {
 
     let (answers, total) = run_fc(&Value::Array(set.clone()));
     let errors = answers.iter().filter(|a| a.get("error").is_some()).count();
-    assert_eq!((answers.len(), errors), (count, 0), "every problem answered");
+    assert_eq!(
+        (answers.len(), errors),
+        (count, 0),
+        "every problem answered"
+    );
     let closed = answers
         .iter()
         .filter(|a| a["exact"]["force_closure"] == true)

@@ -287,7 +287,11 @@ fn open_session(config: &HostConfig) -> Result<zenoh::Session> {
         return config.bus.open();
     }
     let mut zenoh_config = config.bus.to_zenoh()?;
-    let cap = config.limits.max_payload_bytes.saturating_mul(2).saturating_add(1 << 20);
+    let cap = config
+        .limits
+        .max_payload_bytes
+        .saturating_mul(2)
+        .saturating_add(1 << 20);
     zenoh_config
         .insert_json5("transport/link/rx/max_message_size", &cap.to_string())
         .map_err(|e| anyhow::anyhow!("zenoh rx max_message_size: {e}"))?;

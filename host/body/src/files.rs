@@ -451,7 +451,11 @@ mod tests {
             let e = roots.resolve(&bad).unwrap_err();
             assert!(matches!(e, FileError::Refused { .. }), "{bad}: {e}");
             // The request is echoed (the client wrote it), the root never is.
-            assert!(!e.to_string().contains(&*base.0.join("root").to_string_lossy()), "{e}");
+            assert!(
+                !e.to_string()
+                    .contains(&*base.0.join("root").to_string_lossy()),
+                "{e}"
+            );
         }
     }
 
@@ -464,17 +468,25 @@ mod tests {
         std::os::unix::fs::symlink("/dev/zero", root.join("zero.stl")).unwrap();
         std::os::unix::fs::symlink("robots/hand.toml", root.join("ok.toml")).unwrap();
         for bad in ["s.toml", "zero.stl"] {
-            assert!(matches!(roots.resolve(bad), Err(FileError::Refused { .. })), "{bad}");
+            assert!(
+                matches!(roots.resolve(bad), Err(FileError::Refused { .. })),
+                "{bad}"
+            );
         }
         assert_eq!(roots.resolve("ok.toml").unwrap().name(), "robots/hand.toml");
         let fifo = root.join("fifo.toml");
         let c = std::ffi::CString::new(fifo.to_string_lossy().as_bytes()).unwrap();
         // SAFETY: a valid NUL-terminated path; mkfifo only creates a node.
         assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
-        assert!(matches!(roots.resolve("fifo.toml"), Err(FileError::Refused { .. })));
+        assert!(matches!(
+            roots.resolve("fifo.toml"),
+            Err(FileError::Refused { .. })
+        ));
         let beside = roots.resolve("robots/hand.toml").unwrap();
         assert!(roots.resolve_beside(&beside, "../ok.toml").is_ok());
-        assert!(roots.resolve_beside(&beside, "../../outside/secret.toml").is_err());
+        assert!(roots
+            .resolve_beside(&beside, "../../outside/secret.toml")
+            .is_err());
     }
 
     #[test]
@@ -489,11 +501,17 @@ mod tests {
         });
         let f = roots.resolve("big.toml").unwrap();
         let e = roots.read(&f, FileKind::Toml).unwrap_err();
-        assert!(e.to_string().contains("big.toml: TOML file is 2000 bytes"), "{e}");
+        assert!(
+            e.to_string().contains("big.toml: TOML file is 2000 bytes"),
+            "{e}"
+        );
         assert_eq!(roots.read(&f, FileKind::Mesh).unwrap().len(), 2000);
         std::fs::write(root.join("bin.toml"), [0xff, 0xfe]).unwrap();
         let f = roots.resolve("bin.toml").unwrap();
-        assert!(matches!(roots.read_string(&f, FileKind::Toml), Err(FileError::NotText { .. })));
+        assert!(matches!(
+            roots.read_string(&f, FileKind::Toml),
+            Err(FileError::NotText { .. })
+        ));
     }
 
     #[test]
@@ -509,8 +527,14 @@ mod tests {
         let m = toml_error(&err, text);
         assert!(m.starts_with("line "), "{m}");
         assert!(!m.contains("hunter2"), "{m}");
-        assert_eq!(redact("unknown field `foo`, expected `bar`"), "unknown field `foo`, expected `bar`");
-        assert_eq!(redact("invalid type: string \"root:$6$x:0\", expected u32"), "invalid type: string \"…\", expected u32");
+        assert_eq!(
+            redact("unknown field `foo`, expected `bar`"),
+            "unknown field `foo`, expected `bar`"
+        );
+        assert_eq!(
+            redact("invalid type: string \"root:$6$x:0\", expected u32"),
+            "invalid type: string \"…\", expected u32"
+        );
         assert_eq!(line_column("ab\ncd", 4), (2, 2));
     }
 }

@@ -117,7 +117,11 @@ fn hull_epsilon(points: &[Wrench]) -> Option<f64> {
 /// Smallest facet distance from the origin of a built hull of `points`.
 fn facet_epsilon(h: &Hull, points: &[Wrench]) -> Option<f64> {
     // Qhull: normal·x + offset ≤ 0 inside, unit outward normal.
-    let mut eps = h.facets.iter().map(|f| -f.offset).fold(f64::INFINITY, f64::min);
+    let mut eps = h
+        .facets
+        .iter()
+        .map(|f| -f.offset)
+        .fold(f64::INFINITY, f64::min);
     // A facet through the origin comes out at ±1e-16 of it: rounding, not quality.
     let scale = points.iter().map(|p| p.norm()).fold(0.0, f64::max);
     if eps.abs() <= ZERO_TOLERANCE * scale {
@@ -171,7 +175,12 @@ pub fn epsilon_linf(
             return Ok(eps.unwrap_or(0.0).max(0.0));
         }
         set = match built {
-            Some(h) => h.vertices.iter().filter_map(|&i| next.get(i)).copied().collect(),
+            Some(h) => h
+                .vertices
+                .iter()
+                .filter_map(|&i| next.get(i))
+                .copied()
+                .collect(),
             // Not yet full-dimensional: keep every candidate (still few).
             None => next,
         };

@@ -30,7 +30,10 @@ fn compute() -> Vec<Row> {
         ..FerrariCannyOptions::default()
     };
     let mut rows = Vec::new();
-    for (s, shape) in [common::Shape::Can, common::Shape::Box].into_iter().enumerate() {
+    for (s, shape) in [common::Shape::Can, common::Shape::Box]
+        .into_iter()
+        .enumerate()
+    {
         let mut linf_done = 0;
         for i in 0..PER_SHAPE {
             let n = CONTACTS[i % CONTACTS.len()];
@@ -76,7 +79,10 @@ fn compare(pairs: &[(f64, f64)]) -> (f64, usize) {
         .iter()
         .map(|(a, b)| (a - b).abs() / b.abs().max(1.0))
         .fold(0.0, f64::max);
-    let flipped = pairs.iter().filter(|(a, b)| (*a > 0.0) != (*b > 0.0)).count();
+    let flipped = pairs
+        .iter()
+        .filter(|(a, b)| (*a > 0.0) != (*b > 0.0))
+        .count();
     (worst, flipped)
 }
 

@@ -369,7 +369,7 @@ pub struct PlanOptions {
     /// Random seed; the same seed and state give the same result.
     #[serde(default)]
     pub seed: u64,
-    /// Maximum number of random samples of Algorithm 1 per candidate (default 300).
+    /// Maximum number of random samples of Algorithm 1 per candidate (default 1000).
     #[serde(default = "default_max_samples")]
     pub max_samples: u32,
     /// Wall-clock budget for the whole plan in milliseconds. Default: none —
@@ -397,7 +397,7 @@ pub struct PlanOptions {
 }
 
 fn default_max_samples() -> u32 {
-    300
+    1000
 }
 fn default_max_candidates() -> u32 {
     6

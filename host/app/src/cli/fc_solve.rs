@@ -163,12 +163,13 @@ fn run_ellipsoid(
         });
     }
     let t0 = Instant::now();
-    let t = multi_ellipsoid_test(grasp, &models, weight, MAX_ELLIPSOID_COMBINATIONS).map_err(
-        |e| ProblemError::MethodFailed {
-            method: "ellipsoid",
-            message: e.to_string(),
-        },
-    )?;
+    let t =
+        multi_ellipsoid_test(grasp, &models, weight, MAX_ELLIPSOID_COMBINATIONS).map_err(|e| {
+            ProblemError::MethodFailed {
+                method: "ellipsoid",
+                message: e.to_string(),
+            }
+        })?;
     let time_ns = elapsed_ns(t0);
     Ok(EllipsoidResult {
         force_closure: t.worst.force_closure(delta_f),

@@ -178,12 +178,18 @@ fn finger_jacobian_sets_the_contact_force_limit() {
 #[test]
 fn default_methods_are_the_fast_two() {
     let r = solve(&pinch());
-    assert!(r.get("ellipsoid").is_some() && r.get("exact").is_some(), "{r}");
+    assert!(
+        r.get("ellipsoid").is_some() && r.get("exact").is_some(),
+        "{r}"
+    );
     assert!(r.get("ferrari_canny").is_none(), "{r}");
     let mut twice = pinch();
     twice["methods"] = json!(["exact", "exact", "ferrari_canny"]);
     let r = solve(&twice);
-    assert!(r.get("ellipsoid").is_none() && r["ferrari_canny"]["epsilon_l1"] == 0.0, "{r}");
+    assert!(
+        r.get("ellipsoid").is_none() && r["ferrari_canny"]["epsilon_l1"] == 0.0,
+        "{r}"
+    );
 }
 
 #[test]

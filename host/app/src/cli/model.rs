@@ -4,11 +4,11 @@
 //! [`super::model_report`], which defines them); `--batch FILE` runs thousands of
 //! configurations in one process.
 
+use super::model_report::{self as report, IkRequest};
 use anyhow::{Context, Result};
 use clap::Subcommand;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use super::model_report::{self as report, IkRequest};
 
 /// Subcommands of `tsukami model`.
 #[derive(Subcommand, Debug)]
@@ -17,11 +17,15 @@ pub enum ModelCommand {
     Inspect {
         /// The URDF file.
         file: PathBuf,
+        #[command(flatten)]
+        load: LoadArgs,
     },
     /// Forward kinematics: every link's pose in the root frame.
     Fk {
         /// The URDF file.
         file: PathBuf,
+        #[command(flatten)]
+        load: LoadArgs,
         /// `NAME=VALUE` (radians or metres); joints not given are 0.
         #[arg(long = "joint")]
         joints: Vec<String>,
@@ -33,6 +37,8 @@ pub enum ModelCommand {
     Ik {
         /// The URDF file.
         file: PathBuf,
+        #[command(flatten)]
+        load: LoadArgs,
         /// The link to place.
         #[arg(long)]
         link: Option<String>,
@@ -52,6 +58,36 @@ pub enum ModelCommand {
     },
 }
 
+/// How `tsukami model` loads a URDF (shared by its subcommands).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct LoadArgs {
+    /// A folder holding ROS packages (or a package folder, or `PKG=DIR`) for
+    /// `package://` URIs; repeatable. Searched after ROS_PACKAGE_PATH and
+    /// AMENT_PREFIX_PATH, before the URDF's own ancestors.
+    #[arg(long = "package-dir", value_name = "DIR")]
+    pub package_dirs: Vec<PathBuf>,
+    /// Refuse every quirk that the default lenient reading only warns about.
+    #[arg(long)]
+    pub strict: bool,
+}
+
+/// Loads a URDF for kinematics (meshes that fail are skipped with a warning
+/// on stderr), with the package path from the environment and `--package-dir`.
+fn load(file: &Path, args: &LoadArgs) -> Result<tsukami_body::RobotModel> {
+    let options = tsukami_body::urdf::LoadOptions {
+        strict: args.strict,
+        packages: tsukami_body::packages::PackagePath::default()
+            .with_env()
+            .with_dirs(args.package_dirs.iter().cloned()),
+        ..tsukami_body::urdf::LoadOptions::kinematics_only()
+    };
+    let loaded = tsukami_body::urdf::load_urdf_with(file, &options)?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(loaded.model)
+}
+
 fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
@@ -66,16 +102,17 @@ fn print<T: serde::Serialize>(value: &T) -> Result<()> {
 /// Runs one `tsukami model` subcommand.
 pub fn run(command: &ModelCommand) -> Result<()> {
     match command {
-        ModelCommand::Inspect { file } => {
-            let model = tsukami_body::urdf::load_urdf(file)?;
+        ModelCommand::Inspect { file, load: args } => {
+            let model = load(file, args)?;
             print(&report::inspect(&model))
         }
         ModelCommand::Fk {
             file,
+            load: args,
             joints,
             batch,
         } => {
-            let model = tsukami_body::urdf::load_urdf(file)?;
+            let model = load(file, args)?;
             match batch {
                 Some(path) => {
                     let configurations: Vec<BTreeMap<String, f64>> = read_json(path)?;
@@ -100,8 +137,9 @@ pub fn run(command: &ModelCommand) -> Result<()> {
             joints,
             seed,
             batch,
+            load: args,
         } => {
-            let model = tsukami_body::urdf::load_urdf(file)?;
+            let model = load(file, args)?;
             match batch {
                 Some(path) => {
                     let mut requests: Vec<IkRequest> = read_json(path)?;
