@@ -182,16 +182,17 @@ fn mesh_distance_matches_brute_force() {
             panic!("no result")
         };
         if best > 0.02 {
+            // Inside: our distance is minus the distance from the ball's surface to
+            // the mesh surface.
             let expect = if inside {
-                -(best + 0.015)
+                -(best - 0.015)
             } else {
                 best - 0.015
             };
-            // Inside: our distance is minus the link-to-surface distance.
             let ours = p.distance;
             if inside {
                 assert!(ours < 0.0, "inside point reported at {ours}");
-                assert!((ours + (best - 0.015)).abs() < 1e-6, "{ours} vs {expect}");
+                assert!((ours - expect).abs() < 1e-6, "{ours} vs {expect}");
             } else {
                 assert!((ours - expect).abs() < 1e-6, "{ours} vs {expect}");
                 assert!((p.point_on_object - obj_pose * best_pt).norm() < 1e-6);
