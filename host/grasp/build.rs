@@ -1,7 +1,7 @@
-//! Compiles the vendored Qhull (`qhull/libqhull_r`) and its one entry point
+//! Compiles the vendored Qhull (`vendor/qhull/libqhull_r`) and its one entry point
 //! (`csrc/hull.c`) with the `cc` crate: a C compiler is all this needs.
 
-const QHULL_DIR: &str = "qhull/libqhull_r";
+const QHULL_DIR: &str = "vendor/qhull/libqhull_r";
 const QHULL_SOURCES: [&str; 14] = [
     "geom2_r.c",
     "geom_r.c",

@@ -10,7 +10,7 @@
 //! at 3-D or 4-D), while Qhull handles the degenerate, coplanar wrench sets
 //! grasps produce.
 //!
-//! **How.** Qhull 2020.2 (`libqhull_r`) is vendored in `host/grasp/qhull` and
+//! **How.** Qhull 2020.2 (`libqhull_r`) is vendored in `host/grasp/vendor/qhull` and
 //! compiled by `build.rs` with the `cc` crate — a C compiler is all the build
 //! needs (no bindgen, no libclang). `csrc/hull.c` is the one C function this
 //! module declares by hand; Qhull's errors unwind inside C (its own `setjmp`)
