@@ -1,24 +1,109 @@
 //! Trajectory-planner messages (`<ns>/motion/plan`).
 
-use crate::common::JointMap;
+use crate::common::{JointMap, Pose};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-/// Request of `<ns>/motion/plan`: from a start state to a planned grasp.
+/// Request of `<ns>/motion/plan`: from a start state to a planned grasp, through
+/// reach, approach, close and lift.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MotionPlanRequest {
-    /// Joint positions at the start (joints not given are taken as 0).
-    pub start: JointMap,
-    /// The grasp planner's Plan reply (its `joint_positions` is the goal).
-    pub grasp: serde_json::Value,
-    /// Height to lift the object after closing the hand, metres.
+    /// Joint positions at the start. Joints not given keep the default start: the
+    /// controller's last published state when one answers on `<ns>/controller/state`,
+    /// else the robot's rest posture.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start: Option<JointMap>,
+    /// The grasp: a grasp planner's Plan reply, inline (its other fields are ignored).
+    pub grasp: MotionGrasp,
+    /// Height to lift the object after closing the hand, metres (0 to 0.5).
     #[serde(default = "default_lift")]
     pub lift_height: f64,
+    /// How far back along the approach vector the pre-grasp palm pose is, metres
+    /// (0.005 to 0.3); the approach is a straight line from there to the grasp.
+    #[serde(default = "default_pregrasp")]
+    pub pregrasp_distance: f64,
+    /// Seed of the reach planner's samples (same seed and world, same trajectory).
+    #[serde(default)]
+    pub seed: u64,
+    /// Sample budget of the reach planner (RRT-Connect), 1 to the host's limit.
+    #[serde(default = "default_motion_samples")]
+    pub max_samples: u32,
+    /// Acceleration limit of every joint (rad/s² or m/s²); default: the plugin's
+    /// configured `acceleration`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_acceleration: Option<f64>,
 }
 
 fn default_lift() -> f64 {
     0.05
+}
+
+fn default_pregrasp() -> f64 {
+    0.05
+}
+
+fn default_motion_samples() -> u32 {
+    5000
+}
+
+/// The grasp a motion plan ends in: the fields of a Plan reply it uses. Other
+/// fields are ignored, so a whole Plan reply may be passed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct MotionGrasp {
+    /// The grasp type (its `name` selects the approach vector of the hand's
+    /// grasp-type file).
+    pub grasp_type: MotionGraspType,
+    /// Palm pose in the world frame; must agree with `joint_positions`.
+    pub palm_pose: Pose,
+    /// The grasp posture: every joint the grasp sets (waist, squat, arm, hand).
+    pub joint_positions: JointMap,
+    /// Joints used beyond the arm (waist and squat joints); the reach moves these
+    /// and the arm.
+    #[serde(default)]
+    pub joints_used: Vec<String>,
+    /// Direction the palm moves in along the approach, world frame; default: the
+    /// grasp type's approach vector turned by the palm pose.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub approach: Option<[f64; 3]>,
+}
+
+/// The grasp type of a [`MotionGrasp`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct MotionGraspType {
+    /// Name from the hand's grasp-type file (e.g. `"envelope4_mid"`).
+    pub name: String,
+}
+
+/// Reply of `<ns>/motion/plan`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct MotionPlanReply {
+    /// The trajectory, as `<ns>/controller/execute` takes it; every point's
+    /// `phase` is `reach`, `approach`, `close` or `lift`.
+    pub trajectory: JointTrajectory,
+    /// Where the start came from: `request`, `controller` or `rest` (joints the
+    /// request named come from it in every case).
+    pub start_source: String,
+    /// Samples the reach planner drew.
+    pub samples: u32,
+    /// Configurations checked for collision, over all phases.
+    pub checks: u64,
+    /// Planning time, milliseconds.
+    pub planning_ms: f64,
+    /// The world version (robot, object, obstacles) the motion was planned on.
+    pub world_version: u64,
+}
+
+/// `<ns>/motion/progress`: published while a motion is planned.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct MotionProgress {
+    /// Phase being planned: `reach`, `approach`, `close`, `lift`, `timing`, `done`.
+    pub phase: String,
+    /// Samples the reach planner drew so far.
+    pub samples: u32,
+    /// Milliseconds since the request started.
+    pub elapsed_ms: f64,
 }
 
 /// A joint trajectory: named joints, timed waypoints. The trajectory planner makes
@@ -48,8 +133,8 @@ pub struct TrajectoryPoint {
     /// interpolates linearly between positions).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub velocities: Vec<f64>,
-    /// Which phase this point belongs to: `approach`, `grasp`, `close` or `lift`
-    /// (empty when the maker has no phases).
+    /// Which phase this point belongs to: the trajectory planner's `reach`,
+    /// `approach`, `close`, `lift` (empty when the maker has no phases).
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub phase: String,
 }

@@ -16,9 +16,13 @@
 //! How: a configuration of the planned joints is written into the full joint
 //! vector, mimics are applied, forward kinematics runs once, then
 //! `RobotCollision::first_self_collision` and `first_collision` against the
-//! obstacles with the margin decide. Every check is counted.
+//! obstacles with the margin decide. Two optional rules serve the grasp's last
+//! phases: [`ObjectRule`] (the object to grasp, which some hand links may touch
+//! up to a depth while the hand closes on it) and [`Attached`] (the grasped object
+//! moving with the hand, checked against the obstacles and the rest of the robot).
+//! [`RobotWorld::first_hit`] names what collides. Every check is counted.
 
-use nalgebra::Isometry3;
+use nalgebra::{Isometry3, Vector3};
 use tsukami_body::collision::{CollisionObject, RobotCollision};
 use tsukami_body::kinematics::FkState;
 use tsukami_body::model::{JointId, LinkId, RobotModel};
@@ -44,6 +48,56 @@ pub struct RobotWorld<'a> {
     fk: FkState,
     scratch: Vec<f64>,
     checks: usize,
+    object: Option<ObjectRule<'a>>,
+    attached: Option<Attached>,
+}
+
+/// The object to grasp as a body some hand links may touch.
+#[derive(Clone)]
+pub struct ObjectRule<'a> {
+    /// The object.
+    pub body: &'a CollisionObject,
+    /// Links that may touch it (checked for depth, not overlap).
+    pub touching: Vec<LinkId>,
+    /// How deep a touching link may sink into the object (m).
+    pub tolerance: f64,
+}
+
+/// A grasped object carried by a link.
+#[derive(Clone)]
+pub struct Attached {
+    /// The object, moved with the link.
+    pub body: CollisionObject,
+    /// The link holding it.
+    pub link: LinkId,
+    /// The object's pose in the link's frame.
+    pub relative: Isometry3<f64>,
+    /// The farthest any point of the object is from the link's frame origin (m).
+    pub radius: f64,
+    /// Links not checked against it (the hand holding it).
+    pub holding: Vec<LinkId>,
+    /// Obstacles it rests on at the grasp (indices into the world's obstacles),
+    /// not checked until it has moved `clearance` away from its grasp pose.
+    pub supports: Vec<usize>,
+    /// The object's position at the grasp.
+    pub origin: Vector3<f64>,
+    /// Distance after which the supports are checked too (m).
+    pub clearance: f64,
+}
+
+/// What a configuration collides with: a link and the other body.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Collision {
+    /// The robot link (or `grasped object`).
+    pub link: String,
+    /// The other body: an obstacle's name, `object`, or `link <name>`.
+    pub with: String,
+}
+
+impl std::fmt::Display for Collision {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "`{}` collides with {}", self.link, self.with)
+    }
 }
 
 impl<'a> RobotWorld<'a> {
@@ -74,7 +128,23 @@ impl<'a> RobotWorld<'a> {
             max_travel: DEFAULT_MAX_TRAVEL,
             fk: FkState::new(model),
             checks: 0,
+            object: None,
+            attached: None,
         }
+    }
+
+    /// Adds the object to grasp, which `rule.touching` links may touch.
+    pub fn with_object(mut self, rule: ObjectRule<'a>) -> Self {
+        self.object = Some(rule);
+        self
+    }
+
+    /// Attaches a grasped object to a link; the segment resolution then counts
+    /// the object's reach from that link.
+    pub fn with_attached(mut self, attached: Attached) -> Self {
+        self.sweep = SweepBound::with_attached(self.model, &[(attached.link, attached.radius)]);
+        self.attached = Some(attached);
+        self
     }
 
     /// Sets the largest travel of any link point between two checks (m).
@@ -138,21 +208,91 @@ impl<'a> RobotWorld<'a> {
     }
 }
 
-impl Validity for RobotWorld<'_> {
-    fn is_valid(&mut self, q: &[f64]) -> bool {
+impl RobotWorld<'_> {
+    /// What the configuration `q` of the planned joints collides with, if anything.
+    pub fn first_hit(&mut self, q: &[f64]) -> Option<Collision> {
         self.checks += 1;
         for (&j, &v) in self.joints.iter().zip(q) {
             self.scratch[j] = v;
         }
         self.model.apply_mimics(&mut self.scratch);
         self.model.forward_kinematics(&self.scratch, &mut self.fk);
-        self.collision
-            .first_self_collision(&self.fk, self.margin)
-            .is_none()
-            && self
-                .collision
+        let name = |l: LinkId| self.model.links[l].name.clone();
+        if let Some((a, b)) = self.collision.first_self_collision(&self.fk, self.margin) {
+            return Some(Collision {
+                link: name(a),
+                with: format!("link `{}`", name(b)),
+            });
+        }
+        if let Some(hit) =
+            self.collision
                 .first_collision(&self.fk, &self.links, &self.obstacles, self.margin)
-                .is_none()
+        {
+            return Some(Collision {
+                link: name(hit.link),
+                with: format!("obstacle `{}`", self.obstacles[hit.object].name),
+            });
+        }
+        self.object_hit().or_else(|| self.attached_hit())
+    }
+
+    fn object_hit(&self) -> Option<Collision> {
+        let rule = self.object.as_ref()?;
+        let name = |l: LinkId| self.model.links[l].name.clone();
+        let strict: Vec<LinkId> = self
+            .links
+            .iter()
+            .copied()
+            .filter(|l| !rule.touching.contains(l))
+            .collect();
+        let hit = self
+            .collision
+            .first_collision(&self.fk, &strict, &[rule.body], self.margin)
+            .map(|h| h.link)
+            .or_else(|| {
+                self.collision
+                    .first_penetration(&self.fk, &rule.touching, &[rule.body], rule.tolerance)
+                    .map(|p| p.link)
+            })?;
+        Some(Collision {
+            link: name(hit),
+            with: "the object".into(),
+        })
+    }
+
+    fn attached_hit(&mut self) -> Option<Collision> {
+        let at = self.attached.as_mut()?;
+        let pose = self.fk.pose(at.link) * at.relative;
+        at.body.set_pose(pose);
+        let raised = (pose.translation.vector - at.origin).norm() >= at.clearance;
+        let carried = "the grasped object".to_owned();
+        for (i, o) in self.obstacles.iter().enumerate() {
+            if (raised || !at.supports.contains(&i)) && at.body.intersects(o, self.margin) {
+                return Some(Collision {
+                    link: carried,
+                    with: format!("obstacle `{}`", o.name),
+                });
+            }
+        }
+        let links: Vec<LinkId> = self
+            .links
+            .iter()
+            .copied()
+            .filter(|l| !at.holding.contains(l))
+            .collect();
+        let hit = self
+            .collision
+            .first_collision(&self.fk, &links, &[&at.body], self.margin)?;
+        Some(Collision {
+            link: self.model.links[hit.link].name.clone(),
+            with: carried,
+        })
+    }
+}
+
+impl Validity for RobotWorld<'_> {
+    fn is_valid(&mut self, q: &[f64]) -> bool {
+        self.first_hit(q).is_none()
     }
 }
 

@@ -1,5 +1,6 @@
 //! Tsukami's trajectory planner: turns a planned grasp into a joint trajectory the
-//! controller can play back — reach, approach, close, lift (and retreat).
+//! controller can play back — reach, approach, close, lift — as the
+//! `trajectory-planner` plugin (`<ns>/motion/plan`, [`plugin`]).
 //!
 //! The algorithms are plain modules, independent of the plugin boundary and of the
 //! bus:
@@ -8,12 +9,25 @@
 //! - [`shortcut`]: random shortcut smoothing of a collision-free path;
 //! - [`resolution`]: how finely a straight joint-space segment must be checked so
 //!   that no point of any link moves more than a stated distance between checks;
-//! - [`checker`]: a robot among obstacles as the trees' collision test;
+//! - [`checker`]: a robot among obstacles, the object and a carried object, as the
+//!   trees' collision test;
+//! - [`cartesian`]: straight palm lines (approach, lift) by IK continuation;
 //! - [`timing`]: time scaling of a piecewise-linear path within every joint's
-//!   velocity limit and an acceleration limit.
+//!   velocity limit and an acceleration limit; [`assemble`]: phases into one
+//!   trajectory;
+//! - [`goal`]: the request's start and grasp checked against the robot;
+//! - [`motion`]: the whole pipeline; [`world`]: the planner kit's world, shared
+//!   with the grasp planners; [`error`]: failures and their codes.
 
+pub mod assemble;
+pub mod cartesian;
 pub mod checker;
+pub mod error;
+pub mod goal;
+pub mod motion;
+pub mod plugin;
 pub mod resolution;
 pub mod rrt_connect;
 pub mod shortcut;
 pub mod timing;
+pub mod world;

@@ -221,6 +221,18 @@ pub fn plan<V: Validity, S: SegmentSteps>(
     steps: &S,
     cancelled: &dyn Fn() -> bool,
 ) -> Result<Vec<Vec<f64>>, RrtError> {
+    plan_counted(problem, params, validity, steps, cancelled).map(|(path, _)| path)
+}
+
+/// [`plan`], also returning the number of samples drawn (0 when the straight
+/// segment was free).
+pub fn plan_counted<V: Validity, S: SegmentSteps>(
+    problem: &Problem<'_>,
+    params: &RrtParams,
+    validity: &mut V,
+    steps: &S,
+    cancelled: &dyn Fn() -> bool,
+) -> Result<(Vec<Vec<f64>>, usize), RrtError> {
     let in_bounds = |q: &[f64]| {
         q.iter()
             .zip(problem.lower.iter().zip(problem.upper))
@@ -233,7 +245,7 @@ pub fn plan<V: Validity, S: SegmentSteps>(
         return Err(RrtError::GoalInvalid);
     }
     if segment_valid(validity, steps, problem.start, problem.goal) {
-        return Ok(vec![problem.start.to_vec(), problem.goal.to_vec()]);
+        return Ok((vec![problem.start.to_vec(), problem.goal.to_vec()], 0));
     }
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
     let mut trees = [Tree::new(problem.start), Tree::new(problem.goal)];
@@ -278,7 +290,7 @@ pub fn plan<V: Validity, S: SegmentSteps>(
             if a == 1 {
                 from_a.reverse();
             }
-            return Ok(from_a);
+            return Ok((from_a, k + 1));
         }
     }
     Err(RrtError::Exhausted {

@@ -1,0 +1,94 @@
+//! Motion planning time per paper scene, p50 and p99 over 32 seeds (in-process,
+//! no bus), and the same with shortcutting switched off, in the same run.
+//!
+//! Run: `cargo bench -p tsukami-trajectory-planner --bench motion_scenes`.
+//! Targets (issue #13): table scenes p50 < 50 ms, fridge p50 < 300 ms.
+//! The grasp comes from the paper's planner (seed 0); the motion starts at rest.
+
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use tsukami_grasp_planner::planner::Paper;
+use tsukami_msgs::motion::MotionGrasp;
+use tsukami_msgs::planner::PlanOptions;
+use tsukami_planner_kit::validate::Limits;
+use tsukami_planner_kit::Session;
+use tsukami_scenes::scene_requests;
+use tsukami_trajectory_planner::motion::{plan_motion, MotionConfig, MotionQuery, Variant};
+use tsukami_trajectory_planner::world::SharedWorld;
+
+const SCENES: [&str; 5] = ["can_breast", "can_waist", "heavy_low", "fridge_pet", "vase_table"];
+const SEEDS: u64 = 32;
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    let i = ((sorted.len() as f64 - 1.0) * p).round() as usize;
+    sorted[i]
+}
+
+fn times(world: &Session<SharedWorld>, grasp: &MotionGrasp, variant: Variant) -> (Vec<f64>, u32, f64) {
+    let snapshot = world.snapshot();
+    let w = snapshot.world().unwrap();
+    let cfg = MotionConfig::default();
+    let mut out = Vec::new();
+    let (mut ok, mut duration) = (0, 0.0);
+    for seed in 0..SEEDS {
+        let query = MotionQuery {
+            grasp,
+            start: w.robot.model.rest_positions(),
+            lift_height: 0.05,
+            pregrasp_distance: 0.05,
+            seed,
+            max_samples: 5000,
+            acceleration: cfg.acceleration,
+        };
+        let t = Instant::now();
+        let r = plan_motion(&w, &query, &cfg, &Limits::default(), variant, &|| false, &mut |_, _| {});
+        out.push(t.elapsed().as_secs_f64() * 1e3);
+        if let Ok(m) = r {
+            ok += 1;
+            duration += m.trajectory.points.last().unwrap().time;
+        }
+    }
+    out.sort_by(f64::total_cmp);
+    (out, ok, duration / f64::from(ok.max(1)))
+}
+
+fn main() {
+    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    println!("| scene | p50 ms | p99 ms | ok | trajectory s | no shortcut: p50 ms | p99 ms | trajectory s | p50 ratio (shortcut / none) |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for scene in SCENES {
+        let req = scene_requests(&models.join("scenes").join(format!("{scene}.toml"))).unwrap();
+        let grasps = Session::<Paper>::new(&models);
+        let world = Session::<SharedWorld>::new(&models);
+        for s in [&grasps as &dyn Setup, &world] {
+            s.setup(&req);
+        }
+        let opts = PlanOptions { seed: 0, ..PlanOptions::default() };
+        let reply = grasps.plan(&opts, &AtomicBool::new(false), &mut |_| {}).unwrap();
+        let grasp: MotionGrasp = serde_json::from_value(serde_json::to_value(&reply).unwrap()).unwrap();
+        let (a, ok_a, dur_a) = times(&world, &grasp, Variant::default());
+        let (b, _, dur_b) = times(&world, &grasp, Variant { no_shortcut: true });
+        let (pa, pb) = (percentile(&a, 0.5), percentile(&b, 0.5));
+        println!(
+            "| {scene} | {pa:.1} | {:.1} | {ok_a}/{SEEDS} | {dur_a:.2} | {pb:.1} | {:.1} | {dur_b:.2} | {:.2} |",
+            percentile(&a, 0.99),
+            percentile(&b, 0.99),
+            pa / pb
+        );
+    }
+}
+
+/// Sets a session's world from a scene.
+trait Setup {
+    fn setup(&self, req: &tsukami_scenes::requests::SceneRequests);
+}
+
+impl<P: tsukami_planner_kit::GraspPlanner> Setup for Session<P> {
+    fn setup(&self, req: &tsukami_scenes::requests::SceneRequests) {
+        self.set_robot(&req.robot).unwrap();
+        self.set_object(&req.object).unwrap();
+        self.set_env(&req.env).unwrap();
+    }
+}

@@ -1,0 +1,95 @@
+//! In-process: each paper scene's grasp (the paper's planner, seed 0) is reached
+//! from rest, phases in order, ending at the grasp; the same seed gives the same
+//! trajectory. The full independent re-check runs over the bus in
+//! `tests/tests/motion.rs`.
+
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+use tsukami_grasp_planner::planner::Paper;
+use tsukami_msgs::motion::MotionGrasp;
+use tsukami_msgs::planner::PlanOptions;
+use tsukami_planner_kit::validate::Limits;
+use tsukami_planner_kit::Session;
+use tsukami_scenes::scene_requests;
+use tsukami_trajectory_planner::motion::{plan_motion, Motion, MotionConfig, MotionQuery, Variant};
+use tsukami_trajectory_planner::world::SharedWorld;
+
+fn motion(scene: &str, seed: u64) -> (Motion, MotionGrasp) {
+    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let req = scene_requests(&models.join("scenes").join(format!("{scene}.toml"))).unwrap();
+    let grasps = Session::<Paper>::new(&models);
+    let world = Session::<SharedWorld>::new(&models);
+    grasps.set_robot(&req.robot).unwrap();
+    grasps.set_object(&req.object).unwrap();
+    grasps.set_env(&req.env).unwrap();
+    world.set_robot(&req.robot).unwrap();
+    world.set_object(&req.object).unwrap();
+    world.set_env(&req.env).unwrap();
+    let reply = grasps
+        .plan(&PlanOptions::default(), &AtomicBool::new(false), &mut |_| {})
+        .unwrap();
+    let grasp: MotionGrasp = serde_json::from_value(serde_json::to_value(&reply).unwrap()).unwrap();
+    let snapshot = world.snapshot();
+    let w = snapshot.world().unwrap();
+    let query = MotionQuery {
+        grasp: &grasp,
+        start: w.robot.model.rest_positions(),
+        lift_height: 0.05,
+        pregrasp_distance: 0.05,
+        seed,
+        max_samples: 5000,
+        acceleration: 2.0,
+    };
+    let cfg = MotionConfig::default();
+    let m = plan_motion(&w, &query, &cfg, &Limits::default(), Variant::default(), &|| false, &mut |_, _| {})
+        .unwrap_or_else(|e| panic!("{scene}: {e}"));
+    (m, grasp)
+}
+
+fn check(scene: &str) {
+    let (m, grasp) = motion(scene, 1);
+    let t = &m.trajectory;
+    let mut phases: Vec<&str> = t.points.iter().map(|p| p.phase.as_str()).collect();
+    phases.dedup();
+    assert_eq!(phases, ["reach", "approach", "close", "lift"], "{scene}");
+    let k = t.points.iter().rposition(|p| p.phase == "close").unwrap();
+    for (n, q) in t.joint_names.iter().zip(&t.points[k].positions) {
+        if let Some(g) = grasp.joint_positions.get(n) {
+            assert!((q - g).abs() < 1e-9, "{scene}: {n}");
+        }
+    }
+    assert_eq!(motion(scene, 1).0, m, "{scene}: deterministic");
+    eprintln!(
+        "{scene}: {} points, {:.2} s, {} samples, {} checks",
+        t.points.len(),
+        t.points.last().unwrap().time,
+        m.samples,
+        m.checks
+    );
+}
+
+#[test]
+fn can_breast() {
+    check("can_breast");
+}
+
+#[test]
+fn can_waist() {
+    check("can_waist");
+}
+
+#[test]
+fn heavy_low() {
+    check("heavy_low");
+}
+
+#[test]
+fn fridge_pet() {
+    check("fridge_pet");
+}
+
+#[test]
+fn vase_table() {
+    check("vase_table");
+}
