@@ -10,7 +10,6 @@
 //! `cargo bench -p tsukami-body -- --warm-up-time 1 --measurement-time 3`
 
 use std::hint::black_box;
-use std::path::PathBuf;
 use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -18,29 +17,25 @@ use nalgebra::{Isometry3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tsukami_body::collision::{CollisionObject, DistanceMethod, RobotCollision};
-use tsukami_body::ik::{IkOptions, IkSolver, RIGHT_ARM};
+use tsukami_body::ik::{IkOptions, IkSolver};
 use tsukami_body::kinematics::{FkState, JointSelection};
 use tsukami_body::mesh::TriangleMesh;
 use tsukami_body::RobotModel;
 
-fn models() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models")
-}
-
-fn humanoid() -> RobotModel {
-    tsukami_body::urdf::load_urdf(&models().join("robots/tsukami_humanoid/tsukami_humanoid.urdf"))
-        .unwrap()
-}
+#[path = "../tests/common/mod.rs"]
+mod common;
+use common::{humanoid, models_dir as models};
 
 /// Palm targets from random in-limit arm configurations.
 fn arm_targets(m: &RobotModel, n: usize) -> Vec<Isometry3<f64>> {
     let palm = m.link_id("r_palm").unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(1);
     let mut fk = FkState::new(m);
+    let arm = common::humanoid_groups().arm;
     (0..n)
         .map(|_| {
             let mut q = m.rest_positions();
-            for name in RIGHT_ARM {
+            for name in &arm {
                 let j = m.joint_id(name).unwrap();
                 let l = m.joints[j].limits;
                 q[j] = rng.random_range(l.lower..=l.upper);
@@ -66,7 +61,7 @@ fn bench_fk(c: &mut Criterion) {
 
 fn bench_ik(c: &mut Criterion) {
     let m = humanoid();
-    let sel = JointSelection::from_names(&m, &RIGHT_ARM).unwrap();
+    let sel = JointSelection::from_names(&m, &common::humanoid_groups().arm).unwrap();
     let mut solver =
         IkSolver::new(&m, m.link_id("r_palm").unwrap(), sel, IkOptions::default()).unwrap();
     let rest = m.rest_positions();

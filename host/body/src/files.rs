@@ -205,6 +205,27 @@ impl ModelRoots {
     /// followed and the target must still be inside a root and be a regular
     /// file.
     pub fn resolve(&self, request: &str) -> Result<ModelFile, FileError> {
+        self.resolve_as(request, Self::inside)
+    }
+
+    /// Resolves a folder a request names (a `package://` search folder, say)
+    /// with the rules of [`ModelRoots::resolve`], except that the target
+    /// must be a folder inside a root. Returns its canonical path.
+    pub fn resolve_dir(&self, request: &str) -> Result<PathBuf, FileError> {
+        self.resolve_as(request, |roots, candidate| {
+            let path = std::fs::canonicalize(candidate).ok()?;
+            roots.roots.iter().find(|r| path.starts_with(r))?;
+            std::fs::metadata(&path).ok()?.is_dir().then_some(path)
+        })
+    }
+
+    /// The rules [`ModelRoots::resolve`] documents, with `accept` deciding
+    /// what a candidate path resolves to.
+    fn resolve_as<T>(
+        &self,
+        request: &str,
+        accept: impl Fn(&Self, &Path) -> Option<T>,
+    ) -> Result<T, FileError> {
         let refused = || FileError::Refused {
             name: echo(request),
         };
@@ -213,7 +234,7 @@ impl ModelRoots {
         }
         let asked = Path::new(request);
         if asked.is_absolute() {
-            return self.inside(asked).ok_or_else(refused);
+            return accept(self, asked).ok_or_else(refused);
         }
         if asked
             .components()
@@ -223,7 +244,7 @@ impl ModelRoots {
         }
         self.roots
             .iter()
-            .find_map(|root| self.inside(&root.join(asked)))
+            .find_map(|root| accept(self, &root.join(asked)))
             .ok_or_else(refused)
     }
 

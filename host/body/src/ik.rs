@@ -12,7 +12,10 @@
 //! # use nalgebra::{Isometry3, Vector3};
 //! let robot = load_urdf("models/robots/tsukami_humanoid/tsukami_humanoid.urdf".as_ref()).unwrap();
 //! let palm = robot.link_id("r_palm").unwrap();
-//! let arm = JointSelection::from_names(&robot, &tsukami_body::ik::RIGHT_ARM).unwrap();
+//! // The joint groups come from the robot's description.toml (its `arm` list).
+//! let arm_joints = ["r_shoulder_pitch", "r_shoulder_roll", "r_shoulder_yaw", "r_elbow",
+//!                   "r_wrist_yaw", "r_wrist_pitch", "r_wrist_roll"];
+//! let arm = JointSelection::from_names(&robot, &arm_joints).unwrap();
 //! let mut solver = IkSolver::new(&robot, palm, arm, IkOptions::default()).unwrap();
 //! let target = Isometry3::new(Vector3::new(0.35, -0.25, 1.0), Vector3::new(0.0, 1.57, 0.0));
 //! let sol = solver.solve(&target, true, &robot.rest_positions(), None);
@@ -38,21 +41,6 @@ use rand_chacha::ChaCha8Rng;
 use crate::error::{BodyError, Result};
 use crate::kinematics::{joint_motion, JointSelection};
 use crate::model::{JointId, JointKind, LinkId, RobotModel};
-
-/// The 7 joints of the right arm, shoulder to wrist.
-pub const RIGHT_ARM: [&str; 7] = [
-    "r_shoulder_pitch",
-    "r_shoulder_roll",
-    "r_shoulder_yaw",
-    "r_elbow",
-    "r_wrist_yaw",
-    "r_wrist_pitch",
-    "r_wrist_roll",
-];
-/// The waist joints (yaw, then pitch).
-pub const WAIST: [&str; 2] = ["waist_yaw", "waist_pitch"];
-/// The virtual joint that sets the shoulder height by squatting.
-pub const SQUAT: &str = "squat_z";
 
 /// Solver settings.
 #[derive(Debug, Clone)]

@@ -114,7 +114,7 @@ fn jacobian_matches_finite_differences_with_mimics() {
     let tip = m.link_id("r_index_l4").unwrap();
     // r_index_j3 drives the mimic r_index_j4 on the way to the tip.
     let mut names: Vec<&str> = vec!["squat_z", "waist_yaw", "waist_pitch"];
-    names.extend(tsukami_body::ik::RIGHT_ARM);
+    names.extend(common::humanoid_groups().arm);
     names.extend(["r_index_j1", "r_index_j2", "r_index_j3"]);
     let sel = JointSelection::from_names(&m, &names).unwrap();
     let mut fk = FkState::new(&m);

@@ -4,12 +4,12 @@
 mod common;
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
-use tsukami_body::ik::{IkOptions, IkSolver, RIGHT_ARM, SQUAT, WAIST};
+use tsukami_body::ik::{IkOptions, IkSolver};
 use tsukami_body::kinematics::{FkState, JointSelection};
 
 fn arm_solver<'m>(m: &'m tsukami_body::RobotModel, extra: &[&str]) -> IkSolver<'m> {
     let mut names: Vec<&str> = extra.to_vec();
-    names.extend(RIGHT_ARM);
+    names.extend(common::humanoid_groups().arm);
     let sel = JointSelection::from_names(m, &names).unwrap();
     IkSolver::new(m, m.link_id("r_palm").unwrap(), sel, IkOptions::default()).unwrap()
 }
@@ -22,7 +22,9 @@ fn arm_reaches_random_reachable_targets() {
     let mut rng = common::rng(7);
     let mut fk = FkState::new(&m);
     let rest = m.rest_positions();
-    let arm: Vec<usize> = RIGHT_ARM.iter().map(|n| m.joint_id(n).unwrap()).collect();
+    let arm: Vec<usize> = common::humanoid_groups()
+        .arm
+        .iter().map(|n| m.joint_id(n).unwrap()).collect();
     let (mut ok, n) = (0, 1000);
     let mut iterations = 0;
     for _ in 0..n {
@@ -65,7 +67,7 @@ fn arm_reaches_random_reachable_targets() {
 #[test]
 fn deterministic_for_a_seed() {
     let m = common::humanoid();
-    let mut solver = arm_solver(&m, &WAIST);
+    let mut solver = arm_solver(&m, &common::humanoid_groups().waist);
     let target = Isometry3::from_parts(
         Translation3::new(0.45, -0.35, 0.95),
         UnitQuaternion::from_euler_angles(0.3, 1.2, -0.4),
@@ -101,11 +103,12 @@ fn squat_reaches_what_the_arm_cannot() {
     let rest = m.rest_positions();
     let arm = arm_solver(&m, &[]).solve(&target, true, &rest, None);
     assert!(!arm.ok, "arm alone should fail: {arm:?}");
-    let mut whole = vec![SQUAT];
-    whole.extend(WAIST);
+    let groups = common::humanoid_groups();
+    let mut whole = vec![groups.squat];
+    whole.extend(groups.waist);
     let body = arm_solver(&m, &whole).solve(&target, true, &rest, None);
     assert!(body.ok, "{body:?}");
-    assert!(body.q[m.joint_id(SQUAT).unwrap()] < -0.05);
+    assert!(body.q[m.joint_id(groups.squat).unwrap()] < -0.05);
 }
 
 #[test]

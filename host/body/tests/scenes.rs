@@ -4,7 +4,7 @@
 mod common;
 
 use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
-use tsukami_body::ik::{IkOptions, IkSolver, RIGHT_ARM, SQUAT, WAIST};
+use tsukami_body::ik::{IkOptions, IkSolver};
 use tsukami_body::kinematics::{FkState, JointSelection};
 use tsukami_body::scene::Scene;
 
@@ -66,7 +66,7 @@ fn top_poses(s: &Scene, object: &str, height: f64, gap: f64) -> Vec<Isometry3<f6
 fn reachable(s: &Scene, poses: &[Isometry3<f64>], extra: &[&str]) -> usize {
     let m = &s.robot;
     let mut names: Vec<&str> = extra.to_vec();
-    names.extend(RIGHT_ARM);
+    names.extend(common::humanoid_groups().arm);
     let sel = JointSelection::from_names(m, &names).unwrap();
     let mut solver =
         IkSolver::new(m, m.link_id("r_palm").unwrap(), sel, IkOptions::default()).unwrap();
@@ -144,8 +144,9 @@ fn cans_at_breast_and_waist_height_are_reachable_with_the_arm() {
 
 #[test]
 fn low_objects_need_squatting() {
-    let mut whole = vec![SQUAT];
-    whole.extend(WAIST);
+    let groups = common::humanoid_groups();
+    let mut whole = vec![groups.squat];
+    whole.extend(groups.waist);
     for (name, object, r, h) in [
         ("heavy_low", "can", 0.033, 0.122),
         ("fridge_pet", "pet", 0.0325, 0.205),

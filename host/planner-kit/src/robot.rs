@@ -18,6 +18,7 @@ use nalgebra::Point3;
 use tsukami_body::collision::RobotCollision;
 use tsukami_body::files::FileKind;
 use tsukami_body::model::{Geometry, JointId, LinkId, RobotModel};
+use tsukami_body::packages::PackagePath;
 use tsukami_msgs::planner::{RobotSummary, SetRobot, WholeBody};
 
 use crate::description::{Description, HandSpec};
@@ -247,6 +248,32 @@ impl Hand {
     }
 }
 
+/// The `package://` search folders of a SetRobot request, each resolved
+/// inside the model roots (step 4 of `docs/robots.md`'s search order).
+fn package_path(models: &Models, dirs: &[String]) -> Result<PackagePath, KitError> {
+    if dirs.len() > SetRobot::MAX_PACKAGE_DIRS {
+        return Err(KitError::invalid(
+            "package_dirs",
+            format!(
+                "{} folders given, at most {} allowed",
+                dirs.len(),
+                SetRobot::MAX_PACKAGE_DIRS
+            ),
+        ));
+    }
+    let resolved = dirs
+        .iter()
+        .enumerate()
+        .map(|(i, dir)| {
+            models
+                .roots()
+                .resolve_dir(dir)
+                .map_err(|e| KitError::model(format!("package_dirs[{i}]"), e.to_string()))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(PackagePath::default().with_dirs(resolved))
+}
+
 impl Robot {
     /// Loads the robot `req` names: its description, URDF and grasp types
     /// (`req.grasp_types` overrides the first hand's file).
@@ -256,7 +283,13 @@ impl Robot {
         let description = Description::parse(&text, file.name())?;
         let urdf = models.beside(&file, &description.urdf, "robot")?;
         let xml = models.read(&urdf, FileKind::Urdf, "robot")?;
-        let model = tsukami_body::urdf::parse_urdf(&xml, urdf.path()).map_err(|e| {
+        let options = tsukami_body::urdf::LoadOptions {
+            packages: package_path(models, &req.package_dirs)?,
+            ..Default::default()
+        };
+        let model = tsukami_body::urdf::parse_urdf_with(&xml, urdf.path(), &options)
+            .map(|loaded| loaded.model)
+            .map_err(|e| {
             KitError::model(
                 "robot",
                 format!(

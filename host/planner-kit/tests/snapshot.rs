@@ -78,6 +78,7 @@ fn a_plan_never_sees_a_change_made_while_it_runs() {
         .set_robot(&SetRobot {
             robot: "tsukami_humanoid".into(),
             grasp_types: None,
+            package_dirs: Vec::new(),
         })
         .unwrap();
     let first = session.set_object(&can_at(0.45)).unwrap();
@@ -127,6 +128,7 @@ fn a_refused_change_keeps_the_world_and_its_version() {
         .set_robot(&SetRobot {
             robot: "tsukami_humanoid".into(),
             grasp_types: None,
+            package_dirs: Vec::new(),
         })
         .unwrap();
     let ok = session.set_object(&can_at(0.45)).unwrap();

@@ -138,6 +138,7 @@ pub fn scene_requests(path: &Path) -> Result<SceneRequests, SceneError> {
         robot: SetRobot {
             robot: scene.robot_path.display().to_string(),
             grasp_types: None,
+            package_dirs: Vec::new(),
         },
         object,
         env: SetEnv {

@@ -19,6 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     p.set_robot(&SetRobot {
         robot: "tsukami_humanoid".into(),
         grasp_types: None,
+        package_dirs: Vec::new(),
     })?;
     let s = p.set_object(&SetObject {
         name: None,

@@ -18,6 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let request = tsukami_msgs::planner::SetRobot {
         robot: args.first().cloned().unwrap_or("tsukami_humanoid".into()),
         grasp_types: args.get(1).cloned(),
+        package_dirs: Vec::new(),
     };
     let models = tsukami_planner_kit::models::Models::new(["models".into(), ".".into()]);
     let robot = tsukami_planner_kit::Robot::load(&models, &request)?;

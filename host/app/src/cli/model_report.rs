@@ -437,9 +437,19 @@ mod tests {
         let p = target.links["r_palm"];
         let mut t = p.position.to_vec();
         t.extend(p.quaternion);
-        let arm: Vec<String> = tsukami_body::ik::RIGHT_ARM
+        // The arm's joints, as the robot's description lists them.
+        let description: toml::Table = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../models/robots/tsukami_humanoid/description.toml"),
+        )
+        .unwrap()
+        .parse()
+        .unwrap();
+        let arm: Vec<String> = description["hand"][0]["arm"]
+            .as_array()
+            .unwrap()
             .iter()
-            .map(|s| s.to_string())
+            .map(|s| s.as_str().unwrap().to_string())
             .collect();
         let req = IkRequest {
             link: Some("r_palm".into()),

@@ -79,3 +79,35 @@ pub fn closest_on_triangle(p: Vector3<f64>, t: &[Vector3<f64>; 3]) -> Vector3<f6
     let denom = 1.0 / (va + vb + vc);
     a + ab * (vb * denom) + ac * (vc * denom)
 }
+
+/// The humanoid's joint groups, read from its robot description (the names
+/// are data in `description.toml`, not constants in the body crate).
+pub struct Groups {
+    /// The right arm, shoulder to wrist.
+    pub arm: Vec<&'static str>,
+    /// The waist joints the whole-body fallback adds first.
+    pub waist: Vec<&'static str>,
+    /// The virtual squat joint (the description's `whole_body` group).
+    pub squat: &'static str,
+}
+
+/// Reads the humanoid's joint groups from its `description.toml`.
+pub fn humanoid_groups() -> Groups {
+    let path = models_dir().join("robots/tsukami_humanoid/description.toml");
+    let text = std::fs::read_to_string(&path).expect("description reads");
+    let doc: toml::Table = text.parse().expect("description parses");
+    let names = |v: &toml::Value| -> Vec<&'static str> {
+        v.as_array()
+            .expect("a list of joint names")
+            .iter()
+            .map(|n| &*String::from(n.as_str().expect("a joint name")).leak())
+            .collect()
+    };
+    let hand = &doc["hand"].as_array().expect("[[hand]]")[0];
+    let whole_body = names(&doc["whole_body"]);
+    Groups {
+        arm: names(&hand["arm"]),
+        waist: names(&doc["waist"]),
+        squat: whole_body[0],
+    }
+}
