@@ -342,11 +342,10 @@ impl GraspTypeConfig {
     }
 }
 
-#[cfg(test)]
-pub(crate) mod tests {
-    use super::*;
-
-    pub(crate) const MINIMAL: &str = r#"
+/// A grasp-type file with one type, for planners' unit tests: a three-finger
+/// fingertip grasp whose one contact is link `l1`, closed by joint `f1`, with
+/// its GRC boxes around (0.05, 0, 0.06) in the palm frame.
+pub const ONE_TYPE_EXAMPLE: &str = r#"
 [[grasp_type]]
 name = "fingertip3_mid"
 style = "fingertip3"
@@ -361,16 +360,21 @@ grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.02, 0.02] }
 grc_des = { position = [0.05, 0, 0.06], size = [0.06, 0.06, 0.10] }
 "#;
 
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+
     #[test]
     fn parses_minimal_file() {
-        let cfg = GraspTypeConfig::from_toml_str(MINIMAL).unwrap();
+        let cfg = GraspTypeConfig::from_toml_str(ONE_TYPE_EXAMPLE).unwrap();
         assert_eq!(cfg.grasp_types[0].style, GraspStyle::Fingertip3);
         assert_eq!(cfg.grasp_types[0].approach(), Vector3::z());
     }
 
     #[test]
     fn unknown_field_is_an_error_naming_it() {
-        let text = MINIMAL.replace(
+        let text = ONE_TYPE_EXAMPLE.replace(
             "closing_step = 0.02",
             "closing_step = 0.02\nclosing_stp = 1",
         );
@@ -383,7 +387,7 @@ grc_des = { position = [0.05, 0, 0.06], size = [0.06, 0.06, 0.10] }
     #[test]
     fn bad_values_are_errors_naming_the_field() {
         let err = GraspTypeConfig::from_toml_str(
-            &MINIMAL.replace("mass = [0.0, 0.3]", "mass = [0.3, 0.1]"),
+            &ONE_TYPE_EXAMPLE.replace("mass = [0.0, 0.3]", "mass = [0.3, 0.1]"),
         )
         .unwrap_err()
         .to_string();
@@ -392,13 +396,13 @@ grc_des = { position = [0.05, 0, 0.06], size = [0.06, 0.06, 0.10] }
             "{err}"
         );
         let err = GraspTypeConfig::from_toml_str(
-            &MINIMAL.replace("approach = [0, 0, 1]", "approach = [0, 1, 1]"),
+            &ONE_TYPE_EXAMPLE.replace("approach = [0, 0, 1]", "approach = [0, 1, 1]"),
         )
         .unwrap_err()
         .to_string();
         assert!(err.contains("approach"), "{err}");
         let err = GraspTypeConfig::from_toml_str(
-            &MINIMAL.replace("size = [0.02, 0.02, 0.02]", "size = [0.2, 0.02, 0.02]"),
+            &ONE_TYPE_EXAMPLE.replace("size = [0.02, 0.02, 0.02]", "size = [0.2, 0.02, 0.02]"),
         )
         .unwrap_err()
         .to_string();

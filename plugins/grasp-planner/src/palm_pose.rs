@@ -118,7 +118,7 @@ mod tests {
 
     #[test]
     fn approach_points_into_the_face_and_rotations_are_filtered() {
-        let cfg = GraspTypeConfig::from_toml_str(&crate::grasp_type::tests::MINIMAL.replace(
+        let cfg = GraspTypeConfig::from_toml_str(&crate::grasp_type::ONE_TYPE_EXAMPLE.replace(
             "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.02, 0.02] }",
             "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.09, 0.02] }",
         ))

@@ -214,56 +214,36 @@ mod tests {
         }
     }
 
-    const TYPES: &str = r#"
-[hand]
-palm_link = "r_palm"
-arm_joints = ["a1"]
-wrist_joints = ["a1"]
-contact_distance = 0.002
+    /// One grasp type of the test hand: GRC boxes centred 0.1 m along the
+    /// palm's x axis, `grc_max` 0.30 m wide, the style read off the name.
+    fn grasp_type(name: &str, mass: [f64; 2], min: [f64; 3], des: [f64; 3], max_x: f64) -> String {
+        let style = name.trim_end_matches("_mid");
+        let grc = |s: [f64; 3]| format!("{{ position = [0.1, 0, 0.05], size = {s:?} }}");
+        format!(
+            "[[grasp_type]]\nname = \"{name}\"\nstyle = \"{style}\"\nsize = \"mid\"\n\
+             mass = {mass:?}\napproach = [0, 0, 1]\nclosing_step = 0.02\nposture = {{}}\n\
+             contacts = [{{ link = \"l\", joint = \"j\" }}]\ngrc_max = {}\ngrc_min = {}\n\
+             grc_des = {}\n",
+            grc([max_x, 0.30, 0.30]),
+            grc(min),
+            grc(des)
+        )
+    }
 
-[[grasp_type]]
-name = "fingertip4_mid"
-style = "fingertip4"
-size = "mid"
-mass = [0.0, 0.3]
-approach = [0, 0, 1]
-closing_step = 0.02
-posture = {}
-contacts = [{ link = "l", joint = "j" }]
-grc_max = { position = [0.1, 0, 0.05], size = [0.09, 0.30, 0.30] }
-grc_min = { position = [0.1, 0, 0.05], size = [0.03, 0.085, 0.02] }
-grc_des = { position = [0.1, 0, 0.05], size = [0.065, 0.12, 0.065] }
-
-[[grasp_type]]
-name = "fingertip3_mid"
-style = "fingertip3"
-size = "mid"
-mass = [0.0, 0.3]
-approach = [0, 0, 1]
-closing_step = 0.02
-posture = {}
-contacts = [{ link = "l", joint = "j" }]
-grc_max = { position = [0.1, 0, 0.05], size = [0.09, 0.30, 0.30] }
-grc_min = { position = [0.1, 0, 0.05], size = [0.02, 0.04, 0.01] }
-grc_des = { position = [0.1, 0, 0.05], size = [0.06, 0.06, 0.06] }
-
-[[grasp_type]]
-name = "envelope4_mid"
-style = "envelope4"
-size = "mid"
-mass = [0.25, 1.5]
-approach = [0, 0, 1]
-closing_step = 0.02
-posture = {}
-contacts = [{ link = "l", joint = "j" }]
-grc_max = { position = [0.1, 0, 0.05], size = [0.10, 0.30, 0.30] }
-grc_min = { position = [0.1, 0, 0.05], size = [0.04, 0.085, 0.04] }
-grc_des = { position = [0.1, 0, 0.05], size = [0.07, 0.15, 0.07] }
-"#;
+    /// The test hand's three mid-size types.
+    fn types() -> GraspTypeConfig {
+        let text = [
+            grasp_type("fingertip4_mid", [0.0, 0.3], [0.03, 0.085, 0.02], [0.065, 0.12, 0.065], 0.09),
+            grasp_type("fingertip3_mid", [0.0, 0.3], [0.02, 0.04, 0.01], [0.06, 0.06, 0.06], 0.09),
+            grasp_type("envelope4_mid", [0.25, 1.5], [0.04, 0.085, 0.04], [0.07, 0.15, 0.07], 0.10),
+        ]
+        .concat();
+        GraspTypeConfig::from_toml_str(&text).unwrap()
+    }
 
     #[test]
     fn can_side_and_top_lead_to_different_types() {
-        let cfg = GraspTypeConfig::from_toml_str(TYPES).unwrap();
+        let cfg = types();
         let sel = select(&cfg.grasp_types, &[can_ocp()], 0.15);
         let by = |name: &str| -> Vec<BoxFace> {
             sel.candidates
@@ -297,7 +277,7 @@ grc_des = { position = [0.1, 0, 0.05], size = [0.07, 0.15, 0.07] }
 
     #[test]
     fn heavy_object_gets_the_envelope() {
-        let cfg = GraspTypeConfig::from_toml_str(TYPES).unwrap();
+        let cfg = types();
         let sel = select(&cfg.grasp_types, &[can_ocp()], 0.35);
         assert!(sel
             .candidates
@@ -309,7 +289,7 @@ grc_des = { position = [0.1, 0, 0.05], size = [0.07, 0.15, 0.07] }
 
     #[test]
     fn huge_object_fits_nothing() {
-        let cfg = GraspTypeConfig::from_toml_str(TYPES).unwrap();
+        let cfg = types();
         let mut o = can_ocp();
         o.extents = Vector3::new(0.5, 0.4, 0.4);
         let sel = select(&cfg.grasp_types, &[o], 0.15);
