@@ -193,6 +193,10 @@ listen = ["tcp/127.0.0.1:17447"]
 [[plugin]]
 role = "grasp-planner"
 library = "tsukami_grasp_planner"
+
+[[plugin]]
+role = "trajectory-planner"
+library = "tsukami_trajectory_planner"
 "#;
 
 impl HostConfig {

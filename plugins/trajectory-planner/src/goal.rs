@@ -11,11 +11,15 @@
 //! positions is the client's mistake and is named as such (`invalid_value` with
 //! the field), never a path that ends somewhere else.
 //!
+//! Mimic joints in the grasp (a Plan reply lists them) must agree with their
+//! masters.
+//!
 //! How: the reach joints are the hand's arm, the `joints_used` (each must be one
 //! of the description's waist or whole-body joints), and any other joint the
 //! grasp sets to a value other than the start's. The open hand has every finger's
-//! flex joints at 0 (clamped into their limits); the other hand joints (e.g. the
-//! thumb's opposition) are at their grasp values. The approach direction is the
+//! flex joints at 0 (clamped into their limits), or part way there
+//! ([`Goal::open_by`]); the other hand joints (e.g. the thumb's opposition) are at
+//! their grasp values. The approach direction is the
 //! grasp type's `approach` (palm frame) turned by the palm pose, unless the
 //! request gives one.
 
@@ -43,8 +47,10 @@ pub struct Goal {
     pub hand: Vec<JointId>,
     /// The grasp posture, hand closed (full joint vector).
     pub closed: Vec<f64>,
-    /// The grasp posture, hand open.
+    /// The grasp posture, hand open (see [`Goal::open_by`]).
     pub open: Vec<f64>,
+    /// The fingers' flex joints.
+    pub flex: Vec<JointId>,
     /// The palm pose at the grasp (forward kinematics of `closed`).
     pub palm: Isometry3<f64>,
     /// Unit direction the palm moves in along the approach (world frame).
@@ -196,20 +202,29 @@ pub fn resolve(robot: &Robot, grasp: &MotionGrasp, start: &[f64], limits: &Limit
         ));
     }
     let reach = reach_joints(robot, grasp, &set, start, &closed)?;
-    let mut open = closed.clone();
-    for f in &hand.fingers {
-        for &j in &f.flex {
-            let lim = model.joints[j].limits;
-            open[j] = 0.0f64.clamp(lim.lower, lim.upper);
-        }
-    }
-    model.apply_mimics(&mut open);
-    Ok(Goal {
+    let mut goal = Goal {
         approach: approach_direction(robot, grasp, &palm)?,
         reach,
         hand: hand.joints.clone(),
+        open: closed.clone(),
+        flex: hand.fingers.iter().flat_map(|f| f.flex.iter().copied()).collect(),
         closed,
-        open,
         palm,
-    })
+    };
+    goal.open_by(model, 1.0);
+    Ok(goal)
+}
+
+impl Goal {
+    /// Opens the hand by `opening` (1: every flex joint at 0, clamped into its
+    /// limits; 0: the grasp's angles; linear between).
+    pub fn open_by(&mut self, model: &RobotModel, opening: f64) {
+        self.open.clone_from(&self.closed);
+        for &j in &self.flex {
+            let lim = model.joints[j].limits;
+            let straight = 0.0f64.clamp(lim.lower, lim.upper);
+            self.open[j] = self.closed[j] + opening * (straight - self.closed[j]);
+        }
+        model.apply_mimics(&mut self.open);
+    }
 }

@@ -8,7 +8,8 @@
 //!   object;
 //! - **approach**: the palm moves in a straight line along the approach vector
 //!   from `pregrasp_distance` out to the grasp pose ([`crate::cartesian`]);
-//! - **close**: the fingers move from open to the grasp's angles;
+//! - **close**: the fingers move from open (as wide as [`OPENINGS`] allows
+//!   there: fully straight if nothing is in the way) to the grasp's angles;
 //! - **lift**: the palm moves `lift_height` straight up with the object attached.
 //!
 //! Why: every phase is checked at the same resolution ([`crate::resolution`]: no
@@ -241,6 +242,15 @@ pub fn plan_motion(
     let mut joints = goal.reach.clone();
     joints.extend(goal.hand.iter().copied().filter(|j| !goal.reach.contains(j)));
     let mut s = Scene { model, world, goal, joints, env: world.obstacles.clone(), cfg, checks: 0 };
+    let w = s.free(s.joints.clone(), &query.start);
+    s.check(w, &[s.p(&query.start)])
+        .map_err(|c| infeasible("start_in_collision", "the start posture collides", &c))?;
+    let w = s.touching(&s.goal.closed);
+    s.check(w, &[s.p(&s.goal.closed)])
+        .map_err(|c| infeasible("goal_in_collision", "the grasp posture collides", &c))?;
+    progress("approach", 0);
+    let approach = open_and_approach(&mut s, query.pregrasp_distance)?;
+    let (open, closed) = (s.p(&s.goal.open), s.p(&s.goal.closed));
     let mut start_open = query.start.clone();
     for &j in &s.goal.hand {
         start_open[j] = s.goal.open[j];
@@ -248,20 +258,8 @@ pub fn plan_motion(
     model.apply_mimics(&mut start_open);
     let opening = [s.p(&query.start), s.p(&start_open)];
     let w = s.free(s.joints.clone(), &query.start);
-    s.check(w, &opening[..1])
-        .map_err(|c| infeasible("start_in_collision", "the start posture collides", &c))?;
-    let w = s.free(s.joints.clone(), &query.start);
     s.check(w, &opening)
         .map_err(|c| infeasible("start_in_collision", "opening the hand at the start collides", &c))?;
-    let (open, closed) = (s.p(&s.goal.open), s.p(&s.goal.closed));
-    let w = s.touching(&s.goal.open);
-    s.check(w, &[open.clone()])
-        .map_err(|c| infeasible("goal_in_collision", "the grasp posture with the hand open collides", &c))?;
-    let w = s.touching(&s.goal.open);
-    s.check(w, &[closed.clone()])
-        .map_err(|c| infeasible("goal_in_collision", "the grasp posture collides", &c))?;
-    progress("approach", 0);
-    let approach = approach_path(&mut s, query.pregrasp_distance)?;
     progress("reach", 0);
     let (reach, samples) = reach_path(&mut s, query, &start_open, &approach[0], variant, cancelled)?;
     let mut reach_phase = vec![opening[0].clone()];
@@ -276,6 +274,31 @@ pub fn plan_motion(
     let trajectory = timed(&s, query, [reach_phase, approach.iter().map(|q| s.p(q)).collect(), vec![open, closed], lift]);
     progress("done", samples);
     Ok(Motion { trajectory, samples, checks: s.checks })
+}
+
+/// How far the hand opens for the approach, tried in order: as wide as the
+/// obstacles and the object let it (1: fingers straight).
+pub const OPENINGS: [f64; 4] = [1.0, 0.75, 0.5, 0.25];
+
+/// Opens the hand as wide as [`OPENINGS`] allows at the grasp and along the
+/// approach; the approach path. The widest opening's failure when none works.
+fn open_and_approach(s: &mut Scene<'_>, distance: f64) -> Result<Vec<Vec<f64>>, MotionError> {
+    let mut first = None;
+    for opening in OPENINGS {
+        s.goal.open_by(s.model, opening);
+        let w = s.touching(&s.goal.open);
+        let tried = s
+            .check(w, &[s.p(&s.goal.open)])
+            .map_err(|c| infeasible("goal_in_collision", "the grasp posture with the hand open collides", &c))
+            .and_then(|()| approach_path(s, distance));
+        match tried {
+            Ok(path) => return Ok(path),
+            Err(e) => {
+                first.get_or_insert(e);
+            }
+        }
+    }
+    Err(first.expect("OPENINGS is not empty"))
 }
 
 /// The approach, pre-grasp first, grasp (hand open) last, as full configurations.
