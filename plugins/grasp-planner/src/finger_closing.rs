@@ -19,19 +19,17 @@
 //! object) the last step is bisected so the finger ends just touching. A
 //! finger that reaches its joint limit without touching, or starts inside the
 //! object, fails the whole closing. The force limit is `min_j τ_max,j / |Jᵀn|`
-//! over the finger's joints (`tsukami-grasp`).
+//! over the finger's joints, capped by the description's `max_finger_force`
+//! (the kit's `blocks::force`, the rule every planner shares).
 
-use nalgebra::{DVector, Matrix3xX, Point3, Vector3};
+use nalgebra::{Point3, Vector3};
 use tsukami_body::collision::CollisionObject;
 use tsukami_body::collision::Proximity;
-use tsukami_body::kinematics::{FkState, JointSelection};
+use tsukami_body::kinematics::FkState;
 use tsukami_body::model::{JointId, LinkId, RobotModel};
-use tsukami_grasp::finger_force::max_finger_force;
+use tsukami_planner_kit::blocks::force::finger_force;
 
 use crate::hand::{HandModel, ResolvedContact};
-
-/// Cap on a finger's force when no joint limits it (N).
-pub const MAX_FINGER_FORCE: f64 = 100.0;
 
 /// One finger contact, world frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -166,7 +164,17 @@ fn close_one(
     }
     let (link, prox) = near;
     let normal = -prox.normal.into_inner();
-    let f_max = finger_force(hand, c, link, fk, &prox.point_on_object, &normal);
+    // The kit's one rule: the effort limit through the finger's Jacobian,
+    // capped by the description's `max_finger_force`, 0 N if not computable.
+    let f_max = finger_force(
+        &hand.robot,
+        fk,
+        &c.finger_joints,
+        link,
+        &prox.point_on_object,
+        &normal,
+        hand.max_finger_force,
+    );
     Some(FingerContact {
         link,
         position: prox.point_on_object,
@@ -174,31 +182,4 @@ fn close_one(
         f_max,
         distance: prox.distance,
     })
-}
-
-/// Largest normal force the finger of `c` can press with at `point` along `normal`.
-fn finger_force(
-    hand: &HandModel,
-    c: &ResolvedContact,
-    link: LinkId,
-    fk: &FkState,
-    point: &Point3<f64>,
-    normal: &Vector3<f64>,
-) -> f64 {
-    let Ok(sel) = JointSelection::new(&hand.robot, &c.finger_joints) else {
-        return MAX_FINGER_FORCE;
-    };
-    let local = fk.pose(link).inverse() * point;
-    let j6 = hand.robot.jacobian(fk, link, &local, &sel);
-    let j = Matrix3xX::from_fn(sel.len(), |r, k| j6[(r, k)]);
-    let efforts = DVector::from_iterator(
-        sel.len(),
-        sel.joints
-            .iter()
-            .map(|&jid| hand.robot.joints[jid].limits.effort),
-    );
-    match max_finger_force(&j, &efforts, normal) {
-        Ok(f) => f.force.min(MAX_FINGER_FORCE),
-        Err(_) => 0.0,
-    }
 }

@@ -52,6 +52,8 @@ pub struct HandModel {
     pub config: GraspTypeConfig,
     /// Finger closing stops when the link–object distance is under this (m).
     pub contact_distance: f64,
+    /// Cap on a finger's normal force (N), from the robot description.
+    pub max_finger_force: f64,
     /// Palm link.
     pub palm: LinkId,
     /// Arm joints.
@@ -116,6 +118,7 @@ impl HandModel {
             collision: hand.collision.clone(),
             config: hand.grasp_types.clone(),
             contact_distance: hand.contact_distance,
+            max_finger_force: hand.max_finger_force,
             palm: hand.palm,
             arm: hand.arm.clone(),
             wrist: hand.wrist.clone(),
