@@ -300,16 +300,12 @@ fn open_session(config: &HostConfig) -> Result<zenoh::Session> {
         .map_err(|e| anyhow::anyhow!("opening the zenoh session: {e}"))
 }
 
-/// The built-in roles no configured plugin fills (the host answers their `stop`).
-fn unserved_roles(config: &HostConfig) -> Vec<&'static str> {
-    [
-        keys::ROLE_GRASP_PLANNER,
-        keys::ROLE_TRAJECTORY_PLANNER,
-        keys::ROLE_RESULT_VIEWER,
-    ]
-    .into_iter()
-    .filter(|role| config.plugins.iter().all(|p| p.role != *role))
-    .collect()
+/// The key prefixes this host answers itself: its plugins' roles, and `world`
+/// when it holds a world. `stop` on any other prefix is answered `no_plugin`.
+fn served_prefixes(config: &HostConfig, world: bool) -> Vec<String> {
+    let roles = config.plugins.iter().map(|p| keys::role_prefix(&p.role));
+    let world = world.then_some(keys::world::PREFIX);
+    roles.chain(world).map(str::to_owned).collect()
 }
 
 /// A plugin's file as `host/plugins` lists it: the file name only, never the
@@ -436,10 +432,9 @@ impl RunningHost {
             });
         }
 
-        for role in unserved_roles(config) {
-            host.queryables
-                .push(Self::answer_stop_without_plugin(&session, &keys, role)?);
-        }
+        let served = served_prefixes(config, world.is_some());
+        host.queryables
+            .push(Self::answer_stop_without_plugin(&session, &keys, served)?);
         let listing = serde_json::to_vec(&host.plugins)?;
         let plugins_queryable = session
             .declare_queryable(keys.host_plugins())
@@ -516,23 +511,39 @@ impl RunningHost {
             .map_err(|e| anyhow::anyhow!("declaring {wildcard}: {e}"))
     }
 
-    /// `<ns>/<prefix>/stop` for a built-in role no plugin fills: answered with
-    /// `no_plugin` (a garbage payload still gets `malformed_json` /
-    /// `invalid_request`).
+    /// `<ns>/*/stop` for every prefix not in `served` — a built-in role no plugin
+    /// fills, an unknown role, an absent component: answered with `no_plugin`
+    /// naming the role (`details.role`); a garbage payload still gets
+    /// `malformed_json` / `invalid_request`. A served prefix is left to its own
+    /// queryable. Declared not complete, so that where a component serves its own
+    /// `<prefix>/stop` as a complete queryable (as `tsukami_bus::Component` does),
+    /// zenoh's default query target (best matching) sends the query there only.
     fn answer_stop_without_plugin(
         session: &zenoh::Session,
         keys: &KeySpace,
-        role: &'static str,
+        served: Vec<String>,
     ) -> Result<Queryable<()>> {
-        let key = keys.command(role, keys::STOP);
+        let key = keys.key(&format!("*/{}", keys::STOP));
+        let prefix = keys.key("");
         session
             .declare_queryable(&key)
+            .complete(false)
             .callback(move |query| {
+                let key = query.key_expr().as_str();
+                let role = key
+                    .strip_prefix(prefix.as_str())
+                    .and_then(|k| k.strip_suffix(&format!("/{}", keys::STOP)))
+                    .unwrap_or(key)
+                    .to_owned();
+                if served.contains(&role) {
+                    return; // the role's own queryable answers
+                }
                 let error = check_payload(&query, 1 << 20).err().unwrap_or_else(|| {
                     ErrorReply::new(
                         ErrorCode::NoPlugin,
-                        format!("no plugin fills role {role} in this host; nothing to stop"),
+                        format!("no plugin fills role `{role}` in this host; nothing to stop"),
                     )
+                    .with_details(serde_json::json!({ "role": role }))
                 });
                 reply_error(&query, error);
             })

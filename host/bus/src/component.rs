@@ -196,6 +196,10 @@ impl Component {
 
     /// Hands every query on `key` to `callback`, which may keep the `Query` and
     /// reply later from another thread (zenoh sends the reply when it is dropped).
+    ///
+    /// The queryable is declared complete: under zenoh's default query target
+    /// (best matching) a query on `key` goes to it alone, not also to the host's
+    /// fallback `<ns>/*/stop` (which answers `no_plugin` for absent roles).
     pub fn serve_query<F>(&self, key: &str, callback: F) -> Result<Queryable<()>>
     where
         F: Fn(Query) + Send + Sync + 'static,
@@ -203,6 +207,7 @@ impl Component {
         let queryable = self
             .session
             .declare_queryable(key.to_owned())
+            .complete(true)
             .callback(callback)
             .wait()
             .map_err(|e| anyhow!("declaring {key}: {e}"))?;
