@@ -289,16 +289,9 @@ impl Robot {
         };
         let model = tsukami_body::urdf::parse_urdf_with(&xml, urdf.path(), &options)
             .map(|loaded| loaded.model)
-            .map_err(|e| {
-            KitError::model(
-                "robot",
-                format!(
-                    "{}: {}",
-                    urdf.name(),
-                    tsukami_body::files::redact(&e.to_string())
-                ),
-            )
-        })?;
+            // The loader names the file by its absolute path: named relative to
+            // its root instead, nothing quoted from it.
+            .map_err(|e| KitError::model("robot", crate::models::relative_error(&urdf, &e)))?;
         let mut hands = Vec::new();
         for (i, spec) in description.hands.iter().enumerate() {
             let (gt_file, field) = match (&req.grasp_types, i) {
