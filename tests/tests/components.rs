@@ -1,7 +1,9 @@
-//! The components end to end: the host (`tsukami run`) and the controller
-//! (`tsukami-controller`) as separate processes on a real zenoh bus on loopback, with
-//! a vision that answers the can's pose (the in-process mock of `tsukami_e2e::mocks`):
-//! vision finds the can, the planner plans, the grasp posture goes to the controller
+//! The components end to end: the host (`tsukami run`), the vision
+//! (`tsukami-vision serve`, its simulated head camera rendering the can scene) and the
+//! controller (`tsukami-controller`) as separate processes on a real zenoh bus on
+//! loopback: vision finds the can in a simulated depth image (within 5 mm and 3° of
+//! the scene file's pose, modulo the can's spin), the planner plans with the detected
+//! pose, the grasp posture goes to the controller
 //! as a two-point trajectory, the controller's published state ends at the grasp;
 //! killing the controller mid-run makes the execute request fail with a timeout
 //! error; a restarted controller serves again. Once peer to peer, once with every
@@ -10,9 +12,10 @@
 //! A mock-only variant (in-process host, mock vision, mock controller) is the
 //! headless planner test: it checks what the planner would send to the robot.
 
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
-use std::sync::mpsc;
+use std::sync::{mpsc, Mutex};
 use std::time::{Duration, Instant};
 use tsukami::bus::{free_loopback_port, BusConfig};
 use tsukami::client::{BusClient, RequestError};
@@ -26,6 +29,7 @@ use tsukami_msgs::controller::{ControllerState, ExecuteReply, ExecutionOutcome};
 use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER};
 use tsukami_msgs::motion::{JointTrajectory, TrajectoryPoint};
 use tsukami_msgs::vision::ObjectPose;
+use tsukami_msgs::Pose;
 use tsukami_scenes::{scene_requests, SceneRequests};
 
 const T: Duration = Duration::from_secs(60);
@@ -39,7 +43,8 @@ struct Topology {
     host_args: Vec<String>,
     /// Bus arguments of `tsukami-controller`.
     controller_args: Vec<String>,
-    vision: ComponentArgs,
+    /// Bus arguments of `tsukami-vision serve`.
+    vision_args: Vec<String>,
     client: BusConfig,
     _router: Option<ChildGuard>,
     dir: PathBuf,
@@ -70,10 +75,9 @@ fn peer_to_peer() -> Topology {
         controller_args: ["--listen", &controller, "--connect", &host]
             .map(String::from)
             .to_vec(),
-        vision: ComponentArgs {
-            listen: vec![vision.clone()],
-            ..ComponentArgs::connecting(&namespace, &host)
-        },
+        vision_args: ["--listen", &vision, "--connect", &host]
+            .map(String::from)
+            .to_vec(),
         client: BusConfig {
             connect: vec![host, controller, vision],
             ..BusConfig::connecting("tcp/127.0.0.1:1")
@@ -108,11 +112,8 @@ fn through_router() -> Topology {
     let file = config.display().to_string();
     Topology {
         host_args: vec!["--zenoh-config".into(), file.clone()],
-        controller_args: vec!["--zenoh-config".into(), file],
-        vision: ComponentArgs {
-            zenoh_config: Some(config),
-            ..ComponentArgs::connecting(&namespace, "tcp/127.0.0.1:1")
-        },
+        controller_args: vec!["--zenoh-config".into(), file.clone()],
+        vision_args: vec!["--zenoh-config".into(), file],
         client,
         namespace,
         _router: Some(router),
@@ -129,20 +130,58 @@ fn wait_for_router(client: &BusConfig) {
     }
 }
 
-/// The `tsukami-controller` binary of this build (built when a narrower cargo
-/// command did not build it).
-fn controller_exe() -> PathBuf {
-    let name = format!("tsukami-controller{}", std::env::consts::EXE_SUFFIX);
+/// The binary `name` of package `package`, brought up to date by `cargo build`
+/// once per test process: `cargo test -p tsukami-e2e` builds this package's
+/// binaries only (a dev-dependency builds a package's library, not its binaries),
+/// and a binary left over from an earlier build may be stale.
+fn component_exe(package: &str, name: &str) -> PathBuf {
+    static BUILT: Mutex<Vec<String>> = Mutex::new(Vec::new());
     let dir = tsukami_exe().parent().unwrap().to_owned();
-    if !dir.join(&name).is_file() {
+    let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
+    if !built.iter().any(|p| p == package) {
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-        let status = Command::new(cargo)
-            .args(["build", "-p", "tsukami-controller"])
-            .status()
-            .expect("running cargo build");
-        assert!(status.success(), "cargo build -p tsukami-controller failed");
+        let mut build = Command::new(cargo);
+        build.args(["build", "-p", package, "--bin", name]);
+        if dir.file_name().is_some_and(|d| d == "release") {
+            build.arg("--release");
+        }
+        let status = build.status().expect("running cargo build");
+        assert!(status.success(), "cargo build -p {package} failed");
+        built.push(package.to_owned());
     }
-    dir.join(name)
+    dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX))
+}
+
+fn controller_exe() -> PathBuf {
+    component_exe("tsukami-controller", "tsukami-controller")
+}
+
+/// `tsukami-vision serve` with its simulated head camera on the can scene (the
+/// frame is rendered from `models/scenes/can_breast.toml`, 1 mm depth noise).
+fn spawn_vision(t: &Topology) -> ChildGuard {
+    let models = models_dir().display().to_string();
+    let scene = models_dir()
+        .join("scenes/can_breast.toml")
+        .display()
+        .to_string();
+    let mut args = vec![
+        "serve",
+        "--namespace",
+        &t.namespace,
+        "--models",
+        &models,
+        "--scene",
+        &scene,
+    ];
+    args.extend(t.vision_args.iter().map(String::as_str));
+    ChildGuard(
+        Command::new(component_exe("tsukami-vision", "tsukami-vision"))
+            .args(&args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("spawning tsukami-vision"),
+    )
 }
 
 fn spawn_controller(t: &Topology) -> ChildGuard {
@@ -197,15 +236,15 @@ fn json(reply: Result<Vec<u8>, RequestError>) -> serde_json::Value {
     serde_json::from_slice(&reply.expect("a reply")).expect("reply is JSON")
 }
 
-/// Vision → SetObject → Plan: the planned joint positions.
+/// Vision → SetObject → Plan: the detected pose and the planned joint positions.
 fn detect_and_plan(
     client: &BusClient,
     scene: &SceneRequests,
-) -> serde_json::Map<String, serde_json::Value> {
+) -> (ObjectPose, serde_json::Map<String, serde_json::Value>) {
     let keys = client.keys();
     let detected: ObjectPose = serde_json::from_value(json(client.request_key(
         &keys.vision_detect(),
-        br#"{"object": "can_350ml"}"#,
+        br#"{"object": "can_350ml", "seed": 1}"#,
         T,
     )))
     .unwrap();
@@ -226,10 +265,56 @@ fn detect_and_plan(
     send(planner::SET_OBJECT, &object);
     send(planner::SET_ENV, &serde_json::to_value(&scene.env).unwrap());
     let plan = send(planner::PLAN, &serde_json::json!({"seed": 1}));
-    plan["joint_positions"]
+    let joints = plan["joint_positions"]
         .as_object()
         .expect("joint_positions")
-        .clone()
+        .clone();
+    (detected, joints)
+}
+
+fn isometry(p: &Pose) -> Isometry3<f64> {
+    let [x, y, z, w] = p.quaternion;
+    Isometry3::from_parts(
+        Translation3::from(Vector3::from(p.position)),
+        UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z)),
+    )
+}
+
+/// Position (m) and orientation (rad) error of a detected can against the truth,
+/// modulo its symmetry: the can reports a continuous axis (any spin about it is the
+/// same can), so what counts is where its axis point goes and where its axis points
+/// (under each of its discrete symmetries, if any).
+fn can_error(detected: &ObjectPose, truth: &Pose) -> (f64, f64) {
+    let symmetry = detected
+        .symmetry
+        .as_ref()
+        .expect("the can reports its symmetry");
+    let axis = symmetry.axis.as_ref().expect("the can has a symmetry axis");
+    let (point, direction) = (
+        Point3::from(axis.point),
+        Vector3::from(axis.direction).normalize(),
+    );
+    let estimate = isometry(&detected.pose);
+    let truth = isometry(truth);
+    let identity = Pose {
+        position: [0.0; 3],
+        quaternion: [0.0, 0.0, 0.0, 1.0],
+    };
+    std::iter::once(&identity)
+        .chain(&symmetry.discrete)
+        .map(|g| {
+            let t = truth * isometry(g);
+            let dist = (estimate * point - t * point).norm();
+            let angle = (estimate * direction).angle(&(t * direction));
+            (dist, angle)
+        })
+        .fold((f64::INFINITY, f64::INFINITY), |best, e| {
+            if e.1 < best.1 {
+                e
+            } else {
+                best
+            }
+        })
 }
 
 /// From the controller's current state to `goal` (its joints the controller
@@ -340,8 +425,8 @@ fn state_stream(
 fn vision_plan_execute_kill_restart(t: Topology) {
     let _host = spawn_host(&t);
     let mut controller = spawn_controller(&t);
+    let _vision = spawn_vision(&t);
     let scene = can_scene();
-    let vision = MockVision::start(&t.vision, "can_350ml", scene.object.pose).unwrap();
     let client = BusClient::connect(&t.client, &t.namespace).unwrap();
     client.wait_for_host(T).unwrap();
     let info = client.wait_for_component("controller", T).unwrap();
@@ -349,7 +434,15 @@ fn vision_plan_execute_kill_restart(t: Topology) {
     client.wait_for_component("vision", T).unwrap();
     let (_sub, states) = state_stream(&client);
 
-    let goal = detect_and_plan(&client, &scene);
+    let (detected, goal) = detect_and_plan(&client, &scene);
+    let (dist, angle) = can_error(&detected, &scene.object.pose);
+    assert!(
+        dist < 0.005 && angle.to_degrees() < 3.0,
+        "the can detected {:.2} mm and {:.2}° off the scene's pose: {detected:?}",
+        dist * 1e3,
+        angle.to_degrees()
+    );
+    assert!(detected.confidence >= 0.8, "{detected:?}");
     let rest = current_state(&client);
     let to_grasp = two_points(&rest, &goal, 1.0);
     execute_to_the_end(&client, &states, &to_grasp);
@@ -380,7 +473,6 @@ fn vision_plan_execute_kill_restart(t: Topology) {
     client.wait_for_component("controller", T).unwrap();
     let again = two_points(&current_state(&client), &goal, 1.0);
     execute_to_the_end(&client, &states, &again);
-    vision.close();
 }
 
 /// The start of a two-point trajectory as a goal map.
@@ -442,7 +534,8 @@ fn headless_plan_with_mock_components() {
         .unwrap_err();
     assert_eq!(missing.code(), Some(tsukami_msgs::ErrorCode::Infeasible));
 
-    let goal = detect_and_plan(&client, &scene);
+    let (detected, goal) = detect_and_plan(&client, &scene);
+    assert_eq!(detected.pose, scene.object.pose);
     let rest = ControllerState {
         joint_names: goal.keys().cloned().collect(),
         positions: vec![0.0; goal.len()],
