@@ -30,8 +30,11 @@ pub enum ErrorCode {
     Infeasible,
     /// The call was cancelled by a Stop.
     Cancelled,
-    /// A request to another component timed out.
+    /// A request to another component timed out (it did not answer in time).
     Timeout,
+    /// The request's own wall-clock limit (e.g. a plan's `time_budget_ms`) ran
+    /// out before it finished; distinct from [`ErrorCode::Timeout`].
+    TimeLimit,
     /// The plugin panicked; the host caught it and keeps serving.
     PluginPanicked,
     /// Any other failure inside a plugin or component.
@@ -54,6 +57,7 @@ impl ErrorCode {
             ErrorCode::Infeasible => "infeasible",
             ErrorCode::Cancelled => "cancelled",
             ErrorCode::Timeout => "timeout",
+            ErrorCode::TimeLimit => "time_limit",
             ErrorCode::PluginPanicked => "plugin_panicked",
             ErrorCode::Internal => "internal",
         }
@@ -183,6 +187,7 @@ mod tests {
             ErrorCode::MalformedJson,
             ErrorCode::PluginPanicked,
             ErrorCode::NotReady,
+            ErrorCode::TimeLimit,
         ] {
             assert_eq!(ErrorCode::from_wire(code.as_str()), code);
         }

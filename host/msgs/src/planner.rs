@@ -59,6 +59,17 @@ pub struct SetRobot {
     /// `grasp_types.toml` beside the URDF.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grasp_types: Option<String>,
+    /// Extra folders where `package://PKG/...` mesh URIs are looked up, in
+    /// order (step 4 of the search order in `docs/robots.md`). Each must be a
+    /// folder inside the host's model roots; at most
+    /// [`SetRobot::MAX_PACKAGE_DIRS`].
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub package_dirs: Vec<String>,
+}
+
+impl SetRobot {
+    /// Most entries in [`SetRobot::package_dirs`].
+    pub const MAX_PACKAGE_DIRS: usize = 16;
 }
 
 /// Reply to [`SetRobot`].
@@ -243,6 +254,11 @@ pub struct ObjectSummary {
     /// The world version this object belongs to.
     #[serde(default)]
     pub world_version: u64,
+    /// What was done to the mesh to plan on it, one sentence each: zero-area
+    /// triangles dropped, non-manifold edges, triangles re-wound, an open mesh's
+    /// fallback (inside test and centre of mass). Empty for a tidy closed mesh.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 // ---------------------------------------------------------------------------
@@ -375,7 +391,7 @@ pub struct PlanOptions {
     /// Wall-clock budget for the whole plan in milliseconds. Default: none —
     /// the plan is bounded by its sample budget (`max_samples`,
     /// `max_candidates`) and is deterministic; a budget makes the outcome depend
-    /// on the machine's speed (`timeout` when it runs out).
+    /// on the machine's speed (`time_limit` when it runs out).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_budget_ms: Option<u64>,
     /// Joints beyond the arm the planner may add when the arm alone fails.

@@ -66,7 +66,7 @@ fn geometry(models: &Models, shape: &ObstacleShape, limits: &Limits) -> Result<G
             Geometry::Sphere { radius: *radius }
         }
         ObstacleShape::Mesh { path, scale } => {
-            let (_, mesh) = load_mesh(models, path, *scale, "shape.mesh")?;
+            let (_, mesh, _) = load_mesh(models, path, *scale, "shape.mesh")?;
             let s = scale.unwrap_or(1.0);
             Geometry::Mesh {
                 path: PathBuf::from(path),

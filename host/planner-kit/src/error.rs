@@ -6,10 +6,16 @@
 //!
 //! Why: two planners with their own mappings disagreed (a spent time budget was
 //! `infeasible` in one and `timeout` in the other; details carried `field` in one
-//! and `reason` in the other). With one mapping every planner answers alike.
+//! and `reason` in the other). With one mapping every planner answers alike. A
+//! request's own wall-clock limit running out is `time_limit`, never `timeout`
+//! (which means a component did not answer).
 //!
 //! How: `code` is a `tsukami_msgs::ErrorCode`; `details` always holds `reason` (a
-//! stable machine-readable word) and, when a request field was wrong, `field`.
+//! stable machine-readable word) and, when a request field was wrong, `field`. A
+//! failed plan's details add `samples`, `world_version` and the run's bounded
+//! tables (`crate::run`): `rejections` (per reason, `verification` counting the
+//! samples the final check refused), `blockers` (per `"<link> vs <obstacle>"`)
+//! and `blocked_by` (per obstacle, support or `the object`).
 //!
 //! ```
 //! use tsukami_planner_kit::KitError;
@@ -18,6 +24,8 @@
 //! assert_eq!(wire.code, "invalid_value");
 //! assert!(wire.details_json.contains(r#""field":"pose.position""#));
 //! ```
+
+use std::collections::BTreeMap;
 
 use tsukami_msgs::ErrorCode;
 use tsukami_plugin_api::CallError;
@@ -45,9 +53,31 @@ pub enum Stop {
     /// A `stop` request raised the cancel flag.
     #[error("plan cancelled by stop")]
     Cancelled,
-    /// The request's `time_budget_ms` ran out.
-    #[error("time budget of {0} ms exhausted before a grasp was found")]
+    /// The request's `time_budget_ms` ran out (`time_limit`).
+    #[error("the request's time limit (time_budget_ms = {0}) ran out before a grasp was found")]
     OutOfTime(u64),
+}
+
+/// The rejection tables of a failed plan (see [`crate::Run`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RejectionTables {
+    /// Rejected samples per reason.
+    pub rejections: BTreeMap<String, u32>,
+    /// Blocked samples per `"<link> vs <obstacle>"`.
+    pub blockers: BTreeMap<String, u32>,
+    /// Blocked samples per obstacle.
+    pub blocked_by: BTreeMap<String, u32>,
+}
+
+impl RejectionTables {
+    /// The tables of a run.
+    pub fn of(run: &crate::Run) -> Box<Self> {
+        Box::new(RejectionTables {
+            rejections: run.rejections().clone(),
+            blockers: run.blockers().clone(),
+            blocked_by: run.blocked_by(),
+        })
+    }
 }
 
 /// A failed request, as every kit planner reports it.
@@ -97,6 +127,9 @@ pub enum KitError {
         summary: String,
         /// The world version the plan ran on.
         world_version: u64,
+        /// Rejections per reason, blockers per link and obstacle, blocked
+        /// samples per obstacle (bounded tables of [`crate::Run`]).
+        tables: Box<RejectionTables>,
     },
     /// A returned grasp failed the kit's verification (a planner bug).
     #[error("the planner returned a grasp that fails verification: {0}")]
@@ -144,7 +177,7 @@ impl KitError {
             KitError::World { .. } | KitError::Unverified(_) => ErrorCode::Internal,
             KitError::NoGrasp { no_grasp, .. } => match no_grasp {
                 NoGrasp::Stopped(Stop::Cancelled) => ErrorCode::Cancelled,
-                NoGrasp::Stopped(Stop::OutOfTime(_)) => ErrorCode::Timeout,
+                NoGrasp::Stopped(Stop::OutOfTime(_)) => ErrorCode::TimeLimit,
                 _ => ErrorCode::Infeasible,
             },
         }
@@ -181,10 +214,21 @@ impl KitError {
             KitError::NoGrasp {
                 samples,
                 world_version,
+                tables,
                 ..
             } => {
                 d["samples"] = (*samples).into();
                 d["world_version"] = (*world_version).into();
+                let t = tables.as_ref();
+                for (key, table) in [
+                    ("rejections", &t.rejections),
+                    ("blockers", &t.blockers),
+                    ("blocked_by", &t.blocked_by),
+                ] {
+                    if !table.is_empty() {
+                        d[key] = serde_json::json!(table);
+                    }
+                }
             }
             KitError::NotReady { command, .. } => d["missing"] = (*command).into(),
             _ => {}
@@ -211,9 +255,18 @@ mod tests {
             samples: 3,
             summary: String::new(),
             world_version: 1,
+            tables: Box::new(RejectionTables {
+                rejections: [("verification".to_string(), 2)].into(),
+                ..RejectionTables::default()
+            }),
         };
         assert_eq!(e(Stop::Cancelled).code(), ErrorCode::Cancelled);
-        assert_eq!(e(Stop::OutOfTime(5)).code(), ErrorCode::Timeout);
+        assert_eq!(e(Stop::OutOfTime(5)).code(), ErrorCode::TimeLimit);
+        assert_eq!(
+            e(Stop::OutOfTime(5)).details()["rejections"]["verification"],
+            2
+        );
+        assert!(e(Stop::OutOfTime(5)).details().get("blockers").is_none());
         assert_eq!(e(Stop::OutOfTime(5)).details()["samples"], 3);
         let m = KitError::model("path", "x").within("shape.mesh");
         assert_eq!(m.details()["field"], "shape.mesh.path");

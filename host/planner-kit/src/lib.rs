@@ -13,6 +13,8 @@
 //!   hands, fingers and grasp types ([`grasp_types`]) by name, from
 //!   `models/robots/<name>/description.toml`;
 //! - **validation** ([`validate`], [`object`], [`env`]): every value checked,
+//!   object meshes as they come ([`mesh_topology`]: open, non-manifold, wound
+//!   at random — repaired or used with a documented fallback, never refused),
 //!   every file read inside the model roots ([`models`]), before state changes;
 //! - **dispatch and errors** ([`session`], [`error`]): one command table, one
 //!   mapping to the wire's error codes;
@@ -57,6 +59,7 @@ pub mod env;
 pub mod error;
 pub mod grasp;
 pub mod grasp_types;
+pub mod mesh_topology;
 pub mod models;
 pub mod object;
 pub mod planner;

@@ -2,30 +2,53 @@
 //!
 //! What: [`Object`] — the triangles in the mesh frame, the pose of that frame in
 //! the world, mass, friction coefficient μ, the centre of mass (world), the
-//! mesh-frame bounding box and a collision body — built by [`Object::build`]
-//! from a `set_object` request after every value passed `crate::validate`.
+//! mesh-frame bounding box, a collision body and the warnings of the
+//! `set_object` reply — built by [`Object::build`] from a `set_object` request
+//! after every value passed `crate::validate` (or by [`Object::from_mesh`] in
+//! process).
 //!
 //! Why: every planner needs the same object, checked the same way: a mass, a
 //! friction or a centre of mass out of range is `invalid_value` naming the field,
-//! a mesh that cannot be used is `model_error`, and nothing changes on either.
+//! a mesh that cannot be read is `model_error`, a mesh over [`MAX_TRIANGLES`] is
+//! `invalid_value` naming the count and the limit, and nothing changes on any of
+//! them. A mesh that is merely untidy is never refused: zero-area triangles are
+//! dropped, open, non-manifold and inconsistently wound meshes are repaired or
+//! used with a documented fallback ([`crate::mesh_topology`]), and the reply's
+//! `warnings` say what was done.
 //!
 //! How: a model name resolves to `objects/<name>/object.toml` inside the model
 //! roots; a mesh path must lie inside them. The default centre of mass is the
-//! centroid of the enclosed volume of a closed mesh, else the box centre.
+//! centroid of the enclosed volume of a closed mesh (non-manifold ones
+//! included), the convex hull's centroid for an open one, else the box centre.
+//! The collision body is a parry mesh with oriented pseudo-normals whenever the
+//! winding is consistent, so a link inside the object is found.
 
 use nalgebra::{Isometry3, Point3, Vector3};
-use tsukami_body::collision::CollisionObject;
+use parry3d_f64::shape::{SharedShape, TriMesh, TriMeshFlags};
+use tsukami_body::collision::{CollisionObject, Part};
+use tsukami_body::convert::to_vec;
 use tsukami_body::files::FileKind;
+use tsukami_body::limits::ParseLimits;
 use tsukami_body::mesh::TriangleMesh;
 use tsukami_body::object::ObjectModel;
 use tsukami_msgs::planner::{BoxFace, FaceBlock, ObjectShape, OcpBox, SetObject};
 
+use crate::mesh_topology::{hull_centroid, prepare, Topology};
 use crate::models::{relative_error, Models};
 use crate::validate::{self, Limits};
 use crate::KitError;
 
-/// Most triangles accepted in an object or obstacle mesh.
-pub const MAX_TRIANGLES: usize = 200_000;
+/// Most triangles accepted in an object or obstacle mesh, the one limit every
+/// planner applies (the grasp planner reads it from here).
+///
+/// Why 2 000 000: scans of everyday objects come with 100k–1M triangles and
+/// must plan as they are. Collision queries go through parry's BVH, so plan
+/// time grows with the logarithm of the size; `set_object` is linear (about a
+/// second per million triangles on the 2-core benchmark machine, see
+/// `docs/benchmarks.md`), and a 2M-triangle mesh needs a few hundred MB while
+/// it is built. The host's `max_mesh_bytes` (64 MiB: 1.3M binary-STL
+/// triangles) usually bounds it first.
+pub const MAX_TRIANGLES: usize = 2_000_000;
 
 /// A placed, checked object.
 #[derive(Debug, Clone)]
@@ -48,6 +71,12 @@ pub struct Object {
     pub aabb: (Point3<f64>, Point3<f64>),
     /// Collision body at `pose`.
     pub collision: CollisionObject,
+    /// Edge topology and what was repaired.
+    pub topology: Topology,
+    /// Enclosed volume (m³): the mesh's when closed, else its convex hull's.
+    pub volume: f64,
+    /// What was done to the mesh, for the `set_object` reply.
+    pub warnings: Vec<String>,
 }
 
 /// Centroid of the volume a closed, outward-oriented mesh encloses
@@ -64,30 +93,43 @@ pub fn volume_centroid(mesh: &TriangleMesh) -> Option<Point3<f64>> {
     (volume > 1e-12).then(|| Point3::from(moment / volume))
 }
 
-/// Loads a mesh file named in a request (inside the roots, size-checked).
+/// Loads a mesh file named in a request (inside the roots, size-checked,
+/// cleaned); also returns the cleaning note for the reply, if it dropped
+/// anything.
 pub fn load_mesh(
     models: &Models,
     path: &str,
     scale: Option<f64>,
     field: &str,
-) -> Result<(String, TriangleMesh), KitError> {
+) -> Result<(String, TriangleMesh, Option<String>), KitError> {
     let s = validate::scale(scale.unwrap_or(1.0), &format!("{field}.scale"))?;
     let file = models.mesh(path, &format!("{field}.path"))?;
     if let Some(n) = binary_stl_triangles(file.path()).filter(|&n| n > MAX_TRIANGLES as u64) {
-        return Err(KitError::model(format!("{field}.path"), huge(n)));
+        return Err(huge(&format!("{field}.path"), n));
     }
-    let mesh = TriangleMesh::load(file.path(), Vector3::repeat(s))
+    let limits = ParseLimits {
+        max_mesh_triangles: MAX_TRIANGLES,
+        ..ParseLimits::default()
+    };
+    let (mesh, cleanup) = TriangleMesh::load_with(file.path(), Vector3::repeat(s), &limits)
         .map_err(|e| KitError::model(format!("{field}.path"), relative_error(&file, &e)))?;
     check_triangles(&mesh, field)?;
     let stem = file
         .path()
         .file_stem()
         .map_or_else(|| "object".into(), |s| s.to_string_lossy().into_owned());
-    Ok((stem, mesh))
+    let note = cleanup
+        .dropped_any()
+        .then(|| format!("mesh cleaned: {}", cleanup.summary()));
+    Ok((stem, mesh, note))
 }
 
-fn huge(n: u64) -> String {
-    format!("mesh is huge: {n} triangles, more than the {MAX_TRIANGLES} accepted; decimate it")
+/// `invalid_value` for a mesh over [`MAX_TRIANGLES`], naming count and limit.
+fn huge(field: &str, n: u64) -> KitError {
+    KitError::invalid(
+        field,
+        format!("the mesh has {n} triangles, more than the {MAX_TRIANGLES} accepted; decimate it"),
+    )
 }
 
 /// The triangle count a binary STL's header states (`None` if not a binary
@@ -107,9 +149,17 @@ fn binary_stl_triangles(path: &std::path::Path) -> Option<u64> {
     (f.metadata().ok()?.len() == 84 + 50 * n).then_some(n)
 }
 
+fn check_triangles_before_cleaning(mesh: &TriangleMesh) -> Result<(), KitError> {
+    match mesh.indices.len() {
+        0 => Err(KitError::model("shape", "the mesh has no triangles")),
+        n if n > MAX_TRIANGLES => Err(huge("shape", n as u64)),
+        _ => Ok(()),
+    }
+}
+
 fn check_triangles(mesh: &TriangleMesh, field: &str) -> Result<(), KitError> {
     if mesh.indices.len() > MAX_TRIANGLES {
-        return Err(KitError::model(field, huge(mesh.indices.len() as u64)));
+        return Err(huge(field, mesh.indices.len() as u64));
     }
     mesh.validate().map_err(|m| KitError::model(field, m))
 }
@@ -124,39 +174,109 @@ fn load_model(models: &Models, name: &str) -> Result<(String, TriangleMesh, f64)
     Ok((m.name, m.mesh, m.friction))
 }
 
+/// The collision body of a prepared mesh: oriented pseudo-normals (inside
+/// tests) whenever the winding is consistent, closed or not.
+pub fn collision_body(
+    name: &str,
+    pose: Isometry3<f64>,
+    mesh: &TriangleMesh,
+    topology: &Topology,
+) -> Result<CollisionObject, String> {
+    let flags = if topology.solid {
+        TriMeshFlags::ORIENTED
+    } else {
+        TriMeshFlags::empty()
+    };
+    let vertices = mesh.vertices.iter().map(to_vec).collect();
+    let trimesh = TriMesh::with_flags(vertices, mesh.indices.clone(), flags)
+        .map_err(|e| format!("cannot build the collision mesh: {e}"))?;
+    let part = Part {
+        origin: tsukami_body::convert::to_pose(&Isometry3::identity()),
+        shape: SharedShape::new(trimesh),
+        solid_mesh: topology.solid,
+    };
+    Ok(CollisionObject::new(name, pose, vec![part]))
+}
+
 impl Object {
     /// Checks every value of `req` and builds the object.
     pub fn build(models: &Models, req: &SetObject, limits: &Limits) -> Result<Self, KitError> {
         let pose = validate::pose(&req.pose, "pose", limits)?;
         let mass = validate::mass(req.mass, "mass", limits)?;
-        let (name, mesh, default_mu) = match &req.shape {
-            ObjectShape::Model { name } => load_model(models, name)?,
+        let (name, mesh, default_mu, note) = match &req.shape {
+            ObjectShape::Model { name } => {
+                let (name, mesh, mu) = load_model(models, name)?;
+                (name, mesh, mu, None)
+            }
             ObjectShape::Mesh { path, scale } => {
-                let (stem, mesh) = load_mesh(models, path, *scale, "shape.mesh")?;
-                (stem, mesh, 0.5)
+                let (stem, mesh, note) = load_mesh(models, path, *scale, "shape.mesh")?;
+                (stem, mesh, 0.5, note)
             }
         };
         let mu = validate::friction(req.friction.unwrap_or(default_mu), "friction", limits)?;
+        let (lo, hi) = mesh.aabb();
+        let com = match &req.center_of_mass {
+            Some(c) => Some(validate::center_of_mass(
+                c,
+                &lo,
+                &hi,
+                "center_of_mass",
+                limits,
+            )?),
+            None => None,
+        };
+        let name = req.name.clone().unwrap_or(name);
+        let mut object = Self::from_mesh(&name, mesh, pose, mass, mu, com, limits.workspace_m)?;
+        object.warnings.splice(0..0, note);
+        Ok(object)
+    }
+
+    /// Builds an object from a mesh in its own frame (cleaned here), without
+    /// files: what [`Object::build`] does after loading, for in-process use
+    /// (tests, benchmarks). `com_local` is in the mesh frame; `None` takes the
+    /// default (see the module documentation). `max_size` bounds the mesh's
+    /// bounding-box diagonal (m).
+    pub fn from_mesh(
+        name: &str,
+        mut mesh: TriangleMesh,
+        pose: Isometry3<f64>,
+        mass: f64,
+        mu: f64,
+        com_local: Option<Point3<f64>>,
+        max_size: f64,
+    ) -> Result<Self, KitError> {
+        check_triangles_before_cleaning(&mesh)?;
+        let cleanup = mesh.clean();
+        let mut warnings: Vec<String> = cleanup
+            .dropped_any()
+            .then(|| format!("mesh cleaned: {}", cleanup.summary()))
+            .into_iter()
+            .collect();
+        check_triangles(&mesh, "shape")?;
         let aabb = mesh.aabb();
         let diagonal = (aabb.1 - aabb.0).norm();
-        if !(1e-3..=limits.workspace_m).contains(&diagonal) {
+        if !(1e-3..=max_size).contains(&diagonal) {
             return Err(KitError::model(
                 "shape",
                 format!("the mesh is {diagonal:.3e} m across; objects must be 1 mm to the workspace size"),
             ));
         }
-        let com_local = match &req.center_of_mass {
-            Some(c) => validate::center_of_mass(c, &aabb.0, &aabb.1, "center_of_mass", limits)?,
-            None if mesh.is_closed() => {
-                volume_centroid(&mesh).unwrap_or_else(|| nalgebra::center(&aabb.0, &aabb.1))
-            }
-            None => nalgebra::center(&aabb.0, &aabb.1),
+        let topology = prepare(&mut mesh);
+        warnings.extend(topology.warnings.iter().cloned());
+        let hull = (!topology.closed)
+            .then(|| hull_centroid(&mesh.vertices))
+            .flatten();
+        let box_centre = nalgebra::center(&aabb.0, &aabb.1);
+        let (default_com, volume) = match (topology.closed, hull) {
+            (true, _) => (volume_centroid(&mesh), mesh.volume()),
+            (false, Some((c, v))) => (Some(c), v),
+            (false, None) => (None, 0.0),
         };
-        let name = req.name.clone().unwrap_or(name);
-        let collision = CollisionObject::from_mesh(&name, pose, &mesh)
+        let com_local = com_local.unwrap_or(default_com.unwrap_or(box_centre));
+        let collision = collision_body(name, pose, &mesh, &topology)
             .map_err(|m| KitError::model("shape", m))?;
         Ok(Object {
-            name,
+            name: name.to_string(),
             center_of_mass: pose * com_local,
             com_local,
             mesh,
@@ -165,6 +285,9 @@ impl Object {
             mu,
             aabb,
             collision,
+            topology,
+            volume,
+            warnings,
         })
     }
 

@@ -3,12 +3,19 @@
 //! What: [`Run`] is handed to `GraspPlanner::plan`. A planner calls
 //! [`Run::sample`] once per sample (it counts the sample and checks the cancel
 //! flag and, only when the request asked for one, the deadline),
-//! [`Run::reject`] with a short reason when a sample fails, [`Run::phase`] when
+//! [`Run::reject`] with a short reason when a sample fails ([`Run::blocked`]
+//! with what blocked it, e.g. `"r_thumb_link2 vs table"`), [`Run::phase`] when
 //! it moves to another phase (which times the phases and publishes a progress
 //! event), and [`Run::margin`] with each ellipsoid margin it computes.
 //!
 //! Why: the same counts, stop rules and progress events for every planner; the
-//! kit turns them into the reply and into the message of a failed plan.
+//! kit turns them into the reply and into the message and `details` of a failed
+//! plan (`rejections`, `blockers`, `blocked_by`).
+//!
+//! How: reasons are owned strings, so a planner may name links and obstacles;
+//! each table keeps at most [`MAX_REASONS`] names of at most [`MAX_REASON_LEN`]
+//! bytes, and counts the rest under [`OTHERS`], so no input makes it grow
+//! without bound.
 //!
 //! ```
 //! use std::sync::atomic::AtomicBool;
@@ -19,8 +26,10 @@
 //! let mut run = Run::new(&cancel, None, &mut progress);
 //! run.sample().unwrap();
 //! run.reject("ik");
+//! run.blocked("r_thumb_link2 vs table", 2);
 //! assert_eq!(run.samples(), 1);
 //! assert!(run.summary().contains("ik 1"));
+//! assert_eq!(run.blocked_by()["table"], 2);
 //! ```
 
 use std::collections::BTreeMap;
@@ -31,6 +40,33 @@ use tsukami_msgs::planner::{PhaseTiming, PlanPhase, ProgressEvent};
 
 use crate::Stop;
 
+/// Most distinct names kept in each rejection table.
+pub const MAX_REASONS: usize = 32;
+/// Longest name kept (bytes; longer names are cut at a character boundary).
+pub const MAX_REASON_LEN: usize = 96;
+/// The name the counts beyond [`MAX_REASONS`] are kept under.
+pub const OTHERS: &str = "(others)";
+
+/// Adds `n` to `name` in a bounded table (see the module documentation).
+fn count(table: &mut BTreeMap<String, u32>, name: &str, n: u32) {
+    if n == 0 {
+        return;
+    }
+    let mut end = name.len().min(MAX_REASON_LEN);
+    while !name.is_char_boundary(end) {
+        end -= 1;
+    }
+    let name = &name[..end];
+    // One slot stays free for OTHERS: at most MAX_REASONS entries in all.
+    let key = if table.contains_key(name) || table.len() + 1 < MAX_REASONS {
+        name
+    } else {
+        OTHERS
+    };
+    let slot = table.entry(key.to_owned()).or_default();
+    *slot = slot.saturating_add(n);
+}
+
 /// The bookkeeping of one plan.
 pub struct Run<'a> {
     cancel: &'a AtomicBool,
@@ -38,7 +74,8 @@ pub struct Run<'a> {
     progress: &'a mut dyn FnMut(&ProgressEvent),
     start: Instant,
     samples: u32,
-    rejections: BTreeMap<&'static str, u32>,
+    rejections: BTreeMap<String, u32>,
+    blockers: BTreeMap<String, u32>,
     best_margin: Option<f64>,
     timing: PhaseTiming,
     phase: (PlanPhase, Instant),
@@ -66,6 +103,7 @@ impl<'a> Run<'a> {
             start,
             samples: 0,
             rejections: BTreeMap::new(),
+            blockers: BTreeMap::new(),
             best_margin: None,
             timing: PhaseTiming::default(),
             phase: (PlanPhase::Selection, start),
@@ -113,10 +151,35 @@ impl<'a> Run<'a> {
     }
 
     /// Records `n` rejections for one reason at once (0 records nothing).
-    pub fn rejected(&mut self, why: &'static str, n: u32) {
-        if n > 0 {
-            *self.rejections.entry(why).or_default() += n;
+    pub fn rejected(&mut self, why: &str, n: u32) {
+        count(&mut self.rejections, why, n);
+    }
+
+    /// Records that `what` blocked `n` samples, named `"<link> vs <obstacle>"`
+    /// (or `"<link> into <obstacle>"`): the obstacle is the text after the last
+    /// `" vs "` / `" into "` ([`Run::blocked_by`]).
+    pub fn blocked(&mut self, what: &str, n: u32) {
+        count(&mut self.blockers, what, n);
+    }
+
+    /// What blocked samples, per link and obstacle.
+    pub fn blockers(&self) -> &BTreeMap<String, u32> {
+        &self.blockers
+    }
+
+    /// Blocked samples per obstacle (or `the object`, or a link for
+    /// self-collision), summed over the links of [`Run::blockers`].
+    pub fn blocked_by(&self) -> BTreeMap<String, u32> {
+        let mut out = BTreeMap::new();
+        for (what, &n) in &self.blockers {
+            let by = [" vs ", " into "]
+                .iter()
+                .filter_map(|sep| what.rfind(sep).map(|i| &what[i + sep.len()..]))
+                .next()
+                .unwrap_or(what);
+            count(&mut out, by, n);
         }
+        out
     }
 
     /// Samples drawn so far.
@@ -125,12 +188,12 @@ impl<'a> Run<'a> {
     }
 
     /// Records why a sample was rejected.
-    pub fn reject(&mut self, why: &'static str) {
-        *self.rejections.entry(why).or_default() += 1;
+    pub fn reject(&mut self, why: &str) {
+        count(&mut self.rejections, why, 1);
     }
 
     /// Rejection counts per reason.
-    pub fn rejections(&self) -> &BTreeMap<&'static str, u32> {
+    pub fn rejections(&self) -> &BTreeMap<String, u32> {
         &self.rejections
     }
 
@@ -189,7 +252,14 @@ impl<'a> Run<'a> {
             .iter()
             .map(|(why, n)| format!("{why} {n}"))
             .collect();
-        format!(
+        let mut blocked: Vec<(String, u32)> = self.blocked_by().into_iter().collect();
+        blocked.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+        let blocked: Vec<String> = blocked
+            .iter()
+            .take(5)
+            .map(|(by, n)| format!("{by} {n}"))
+            .collect();
+        let mut s = format!(
             "{} samples, best margin {}; rejections: {}",
             self.samples,
             self.best_margin
@@ -199,7 +269,12 @@ impl<'a> Run<'a> {
             } else {
                 rejections.join(", ")
             }
-        )
+        );
+        if !blocked.is_empty() {
+            s.push_str("; blocked by: ");
+            s.push_str(&blocked.join(", "));
+        }
+        s
     }
 
     /// Ends the run: the phase times, total included, and the types tried.
@@ -207,5 +282,30 @@ impl<'a> Run<'a> {
         self.phase(PlanPhase::Done, None, &[]);
         self.timing.total = ms(self.start.elapsed());
         (self.timing, self.tried, self.samples)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tables_stay_bounded_and_name_obstacles() {
+        let cancel = AtomicBool::new(false);
+        let mut progress = |_: &ProgressEvent| {};
+        let mut run = Run::new(&cancel, None, &mut progress);
+        for k in 0..1000 {
+            run.reject(&format!("reason {k} {}", "x".repeat(k)));
+            run.blocked(&format!("link{k} vs shelf"), 1);
+        }
+        run.blocked("r_thumb vs table", 3);
+        run.blocked("r_index into the object", 2);
+        assert_eq!(run.rejections().len(), MAX_REASONS);
+        assert_eq!(run.rejections()[OTHERS], 1000 - (MAX_REASONS as u32 - 1));
+        assert!(run.rejections().keys().all(|k| k.len() <= MAX_REASON_LEN));
+        let by = run.blocked_by();
+        assert_eq!(by["shelf"], 31);
+        assert_eq!(by[OTHERS], 1000 - 31 + 3 + 2);
+        assert!(run.summary().contains("blocked by: "), "{}", run.summary());
     }
 }

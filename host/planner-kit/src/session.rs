@@ -230,12 +230,14 @@ impl<P: GraspPlanner> Session<P> {
                     grasp.grasp_type.name
                 );
                 let samples = run.samples();
+                let tables = crate::error::RejectionTables::of(&run);
                 run.finish();
                 Err(KitError::NoGrasp {
                     no_grasp: crate::NoGrasp::NoGraspType(why),
                     samples,
                     summary: String::new(),
                     world_version: world.version,
+                    tables,
                 })
             }
             Ok(grasp) => {
@@ -251,12 +253,14 @@ impl<P: GraspPlanner> Session<P> {
             Err(no_grasp) => {
                 let summary = format!(" ({})", run.summary());
                 let samples = run.samples();
+                let tables = crate::error::RejectionTables::of(&run);
                 run.finish();
                 Err(KitError::NoGrasp {
                     no_grasp,
                     samples,
                     summary,
                     world_version: world.version,
+                    tables,
                 })
             }
         }

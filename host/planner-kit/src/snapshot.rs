@@ -116,6 +116,7 @@ impl<P: GraspPlanner> Snapshot<P> {
                     triangles: object.mesh.indices.len(),
                     regions: planner.regions(&object, &data),
                     world_version: version,
+                    warnings: object.warnings.clone(),
                 };
                 next.object = Some(Arc::new((object, data)));
                 to_json(&summary)

@@ -439,7 +439,7 @@ fn segment_profile(radii: &[f64], params: &OcpParams) -> Vec<std::ops::Range<usi
 /// The OCPs of an object surface given in the world frame, with free faces.
 ///
 /// `vertices` and `triangles` must describe a valid surface (see
-/// [`crate::object::check_mesh`]); degenerate triangles are ignored. Regions are split
+/// [`crate::object::check_mesh`]; open meshes are fine); degenerate triangles are ignored. Regions are split
 /// along the box's longest axis; the support is the horizontal plane under the
 /// object's lowest point.
 pub fn object_ocps(

@@ -16,7 +16,11 @@
 //! GRC axes follow the face's two box axes in the four orders `(u, v)`,
 //! `(v, −u)`, `(−u, −v)`, `(−v, u)`. GRCdes's centre is placed on the OCP's
 //! centre, moved toward the face when the object is deeper than GRCdes (the
-//! hand then holds the part of the object nearest the face).
+//! hand then holds the part of the object nearest the face). When the object
+//! stands on a support (`floor`, the support's height), a hand on a side face
+//! is raised until GRCdes clears the support by [`FLOOR_CLEARANCE`], at most
+//! by half the face's height: on a short mug the lowest finger then closes on
+//! the mug, not on the table.
 
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use tsukami_body::model::JointId;
@@ -26,6 +30,9 @@ use crate::grasp_type::GraspType;
 use crate::hand::HandModel;
 use crate::ocp::Ocp;
 use crate::selection::grc_edges_in_palm;
+
+/// How far above the support GRCdes's lowest corner is kept on a side face (m).
+pub const FLOOR_CLEARANCE: f64 = 0.01;
 
 /// One palm pose candidate on a face.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,8 +44,14 @@ pub struct PalmTarget {
 }
 
 /// Palm poses of the four GRC rotations on `face` of `ocp` that pass the
-/// containment check of section 3.2.
-pub fn palm_targets(g: &GraspType, ocp: &Ocp, face: BoxFace) -> Vec<PalmTarget> {
+/// containment check of section 3.2; `floor` is the height of the support the
+/// object stands on, if any (see the module documentation).
+pub fn palm_targets(
+    g: &GraspType,
+    ocp: &Ocp,
+    face: BoxFace,
+    floor: Option<f64>,
+) -> Vec<PalmTarget> {
     let a = g.approach();
     let ka = a.iamax();
     let sa = a[ka].signum();
@@ -76,7 +89,22 @@ pub fn palm_targets(g: &GraspType, ocp: &Ocp, face: BoxFace) -> Vec<PalmTarget> 
         let rot = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&cols));
         let rot = UnitQuaternion::from_rotation_matrix(&rot);
         let grc_centre = Vector3::from(g.grc_des.position);
-        let palm_pos = target.coords - rot * grc_centre;
+        let mut palm_pos = target.coords - rot * grc_centre;
+        if let Some(floor) = floor {
+            // Half the face's extent along the world vertical: how far the
+            // GRC centre may rise and stay on the face.
+            let reach = 0.5 * (u.z.abs() * eu + v.z.abs() * ev);
+            let half = Vector3::from(g.grc_des.size) * 0.5;
+            let lowest = (0..8)
+                .map(|c| {
+                    let sign = |b: usize| if c >> b & 1 == 1 { 1.0 } else { -1.0 };
+                    let corner = grc_centre
+                        + Vector3::new(sign(0) * half.x, sign(1) * half.y, sign(2) * half.z);
+                    (palm_pos + rot * corner).z
+                })
+                .fold(f64::INFINITY, f64::min);
+            palm_pos.z += (floor + FLOOR_CLEARANCE - lowest).clamp(0.0, reach);
+        }
         out.push(PalmTarget {
             rotation: r as u8,
             palm: Isometry3::from_parts(Translation3::from(palm_pos), rot),
@@ -137,7 +165,7 @@ mod tests {
             blocked: [None; 6],
         };
         // Face +y of the box = world −x: facing the robot.
-        let t = palm_targets(g, &ocp, BoxFace::PosY);
+        let t = palm_targets(g, &ocp, BoxFace::PosY, None);
         // GRCmin's palm-y edge (0.09) only fits along the can's height: 2 of 4 rotations.
         assert_eq!(t.len(), 2);
         for p in &t {
@@ -150,6 +178,6 @@ mod tests {
             assert!((c - ocp.center).norm() < 1e-9);
         }
         // The top is too narrow for this GRCmin.
-        assert!(palm_targets(g, &ocp, BoxFace::PosX).is_empty());
+        assert!(palm_targets(g, &ocp, BoxFace::PosX, None).is_empty());
     }
 }

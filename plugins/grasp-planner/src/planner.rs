@@ -16,7 +16,11 @@
 //! use tsukami_grasp_planner::planner::Planner;
 //! use tsukami_msgs::planner::*;
 //! let p = Planner::new("models");
-//! p.set_robot(&SetRobot { robot: "tsukami_humanoid".into(), grasp_types: None })?;
+//! p.set_robot(&SetRobot {
+//!     robot: "tsukami_humanoid".into(),
+//!     grasp_types: None,
+//!     package_dirs: Vec::new(),
+//! })?;
 //! p.set_object(&SetObject {
 //!     name: None,
 //!     shape: ObjectShape::Model { name: "can_350ml".into() },
@@ -33,7 +37,7 @@ use std::time::{Duration, Instant};
 use nalgebra::Isometry3;
 use tsukami_body::ik::{IkOptions, IkSolver};
 use tsukami_body::kinematics::JointSelection;
-use tsukami_msgs::planner::{OcpBox, PlanOptions, PlanPhase};
+use tsukami_msgs::planner::{FaceBlock, OcpBox, PlanOptions, PlanPhase};
 use tsukami_planner_kit::{FingerContact, Grasp, GraspPlanner, KitError, NoGrasp, Stop};
 use tsukami_planner_kit::{Object, PlannerConfig, PlannerInfo, Robot, Run, World};
 
@@ -110,17 +114,7 @@ impl GraspPlanner for Paper {
     }
 
     fn object_data(&self, o: &Object) -> Result<PlanObject, KitError> {
-        let com = Some(o.com_local);
-        PlanObject::new(
-            &o.name,
-            &o.mesh,
-            o.pose,
-            o.mass,
-            o.mu,
-            com,
-            &self.params.ocp,
-        )
-        .map_err(|e| KitError::model("shape", e.to_string()))
+        PlanObject::new(o, &self.params.ocp).map_err(|e| KitError::model("shape", e.to_string()))
     }
 
     fn regions(&self, _object: &Object, data: &PlanObject) -> Vec<OcpBox> {
@@ -148,6 +142,17 @@ impl GraspPlanner for Paper {
         // Faces resting on a support or blocked by an obstacle are not sampled.
         let mut ocps = object.ocps.clone();
         crate::support::block_faces(&mut ocps, &w.obstacles, &Default::default());
+        // The support's height, when the object stands on one (its lowest point).
+        let floor = ocps
+            .iter()
+            .any(|o| o.blocked.iter().flatten().any(|b| *b == FaceBlock::Support))
+            .then(|| {
+                object
+                    .vertices
+                    .iter()
+                    .map(|v| v.z)
+                    .fold(f64::INFINITY, f64::min)
+            });
         let mut selection = select(&types, &ocps, object.mass);
         for c in &mut selection.candidates {
             c.grasp_type = enabled[c.grasp_type];
@@ -180,8 +185,15 @@ impl GraspPlanner for Paper {
                 false => format!("the arm and {}", extra.join(", ")),
             };
             run.phase(PlanPhase::NominalPose, None, &extra);
-            let mut nominals =
-                self.nominals(hand, object, &selection.candidates, &stage, opts, si, run)?;
+            let mut nominals = self.nominals(
+                hand,
+                object,
+                &selection.candidates,
+                &stage,
+                opts,
+                (si, floor),
+                run,
+            )?;
             if nominals.is_empty() {
                 continue;
             }
@@ -224,23 +236,26 @@ impl GraspPlanner for Paper {
                 }
             }
         }
-        let r = counters.rejections;
-        for (why, n) in [
-            "ik",
-            "collision before closing",
-            "finger closing",
-            "collision after closing",
-            "force closure",
-        ]
-        .into_iter()
-        .zip(r)
-        {
-            run.rejected(why, n);
-        }
+        record_rejections(run, &counters);
         Err(match any_reachable {
             false => NoGrasp::Unreachable(last_stage),
             true => NoGrasp::Exhausted,
         })
+    }
+}
+
+/// Hands the search's counts to the kit: every reason of
+/// [`crate::search::REJECTION_REASONS`] (`verification`: samples the final
+/// check refused) and every blocker (`"<link> vs <obstacle>"`).
+fn record_rejections(run: &mut Run, counters: &Counters) {
+    for (why, n) in crate::search::REJECTION_REASONS
+        .iter()
+        .zip(counters.rejections)
+    {
+        run.rejected(why, n);
+    }
+    for (what, &n) in &counters.blockers {
+        run.blocked(what, n);
     }
 }
 
@@ -289,7 +304,7 @@ impl Paper {
         candidates: &[Candidate],
         stage: &StageJoints,
         opts: &PlanOptions,
-        si: usize,
+        (si, floor): (usize, Option<f64>),
         run: &mut Run,
     ) -> Result<Vec<Nominal>, NoGrasp> {
         let mut q_init = hand.robot.rest_positions();
@@ -314,7 +329,7 @@ impl Paper {
         };
         for cand in candidates {
             let g = &hand.config.grasp_types[cand.grasp_type];
-            for target in palm_targets(g, &object.ocps[cand.region], cand.face) {
+            for target in palm_targets(g, &object.ocps[cand.region], cand.face, floor) {
                 run.check()?;
                 let mut q0 = q_init.clone();
                 hand.set_posture(cand.grasp_type, &mut q0);

@@ -227,7 +227,7 @@ pub fn search(
         .chain(g.touch_allowed.iter())
         .filter_map(|n| robot.link_id(n).ok())
         .collect();
-    let links = LinkSets::new(hand, &contact_links, &allowed);
+    let links = LinkSets::new(hand, &contact_links, &allowed, &stage.extra);
     let object = &ctx.object.collision;
     let mut fk = FkState::new(robot);
     let mut q = q_nominal.to_vec();
@@ -347,7 +347,9 @@ pub fn search(
 
 /// The robot's links with geometry, split by what they may do to the object.
 struct LinkSets {
-    /// Every arm and hand link: none may touch an obstacle.
+    /// Every link the stage moves — arm and hand, and the torso, head and
+    /// other arm when waist or squat joints move them: none may touch an
+    /// obstacle.
     moving: Vec<LinkId>,
     /// Contact and `touch_allowed` links: may touch the object, sink in at
     /// most half the verification tolerance.
@@ -357,11 +359,28 @@ struct LinkSets {
 }
 
 impl LinkSets {
-    fn new(hand: &HandModel, contact_links: &[LinkId], allowed: &[LinkId]) -> Self {
+    fn new(
+        hand: &HandModel,
+        contact_links: &[LinkId],
+        allowed: &[LinkId],
+        extra_joints: &[tsukami_body::JointId],
+    ) -> Self {
+        let robot = &hand.robot;
+        // Links below a waist or squat joint move with it.
+        let mut below: Vec<LinkId> = extra_joints
+            .iter()
+            .map(|&j| robot.joints[j].child)
+            .collect();
+        let mut k = 0;
+        while k < below.len() {
+            below.extend(robot.links[below[k]].children.iter().copied());
+            k += 1;
+        }
         let moving: Vec<LinkId> = hand
             .arm_links
             .iter()
             .chain(hand.hand_links.iter())
+            .chain(hand.body_links.iter().filter(|l| below.contains(l)))
             .copied()
             .filter(|&l| !hand.collision.link_parts(l).is_empty())
             .fold(Vec::new(), |mut v, l| {
