@@ -5,16 +5,14 @@
 //! Targets (issue #13): table scenes p50 < 50 ms, fridge p50 < 300 ms.
 //! The grasp comes from the paper's planner (seed 0); the motion starts at rest.
 
-use std::path::Path;
-use std::sync::atomic::AtomicBool;
+#[path = "../tests/common/grasps.rs"]
+mod grasps;
+
 use std::time::Instant;
 
-use tsukami_grasp_planner::planner::Paper;
 use tsukami_msgs::motion::MotionGrasp;
-use tsukami_msgs::planner::PlanOptions;
 use tsukami_planner_kit::validate::Limits;
 use tsukami_planner_kit::Session;
-use tsukami_scenes::scene_requests;
 use tsukami_trajectory_planner::motion::{plan_motion, MotionConfig, MotionQuery, Variant};
 use tsukami_trajectory_planner::world::SharedWorld;
 
@@ -55,19 +53,10 @@ fn times(world: &Session<SharedWorld>, grasp: &MotionGrasp, variant: Variant) ->
 }
 
 fn main() {
-    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
     println!("| scene | p50 ms | p99 ms | ok | trajectory s | no shortcut: p50 ms | p99 ms | trajectory s | p50 ratio (shortcut / none) |");
     println!("|---|---|---|---|---|---|---|---|---|");
     for scene in SCENES {
-        let req = scene_requests(&models.join("scenes").join(format!("{scene}.toml"))).unwrap();
-        let grasps = Session::<Paper>::new(&models);
-        let world = Session::<SharedWorld>::new(&models);
-        for s in [&grasps as &dyn Setup, &world] {
-            s.setup(&req);
-        }
-        let opts = PlanOptions { seed: 0, ..PlanOptions::default() };
-        let reply = grasps.plan(&opts, &AtomicBool::new(false), &mut |_| {}).unwrap();
-        let grasp: MotionGrasp = serde_json::from_value(serde_json::to_value(&reply).unwrap()).unwrap();
+        let (world, grasp) = grasps::scene(scene, 0);
         let (a, ok_a, dur_a) = times(&world, &grasp, Variant::default());
         let (b, _, dur_b) = times(&world, &grasp, Variant { no_shortcut: true });
         let (pa, pb) = (percentile(&a, 0.5), percentile(&b, 0.5));
@@ -80,15 +69,3 @@ fn main() {
     }
 }
 
-/// Sets a session's world from a scene.
-trait Setup {
-    fn setup(&self, req: &tsukami_scenes::requests::SceneRequests);
-}
-
-impl<P: tsukami_planner_kit::GraspPlanner> Setup for Session<P> {
-    fn setup(&self, req: &tsukami_scenes::requests::SceneRequests) {
-        self.set_robot(&req.robot).unwrap();
-        self.set_object(&req.object).unwrap();
-        self.set_env(&req.env).unwrap();
-    }
-}

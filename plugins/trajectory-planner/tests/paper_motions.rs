@@ -3,33 +3,14 @@
 //! trajectory. The full independent re-check runs over the bus in
 //! `tests/tests/motion.rs`.
 
-use std::path::Path;
-use std::sync::atomic::AtomicBool;
+mod common;
 
-use tsukami_grasp_planner::planner::Paper;
 use tsukami_msgs::motion::MotionGrasp;
-use tsukami_msgs::planner::PlanOptions;
 use tsukami_planner_kit::validate::Limits;
-use tsukami_planner_kit::Session;
-use tsukami_scenes::scene_requests;
 use tsukami_trajectory_planner::motion::{plan_motion, Motion, MotionConfig, MotionQuery, Variant};
-use tsukami_trajectory_planner::world::SharedWorld;
 
 fn motion(scene: &str, seed: u64) -> (Motion, MotionGrasp) {
-    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
-    let req = scene_requests(&models.join("scenes").join(format!("{scene}.toml"))).unwrap();
-    let grasps = Session::<Paper>::new(&models);
-    let world = Session::<SharedWorld>::new(&models);
-    grasps.set_robot(&req.robot).unwrap();
-    grasps.set_object(&req.object).unwrap();
-    grasps.set_env(&req.env).unwrap();
-    world.set_robot(&req.robot).unwrap();
-    world.set_object(&req.object).unwrap();
-    world.set_env(&req.env).unwrap();
-    let reply = grasps
-        .plan(&PlanOptions::default(), &AtomicBool::new(false), &mut |_| {})
-        .unwrap();
-    let grasp: MotionGrasp = serde_json::from_value(serde_json::to_value(&reply).unwrap()).unwrap();
+    let (world, grasp) = common::grasps::scene(scene, 0);
     let snapshot = world.snapshot();
     let w = snapshot.world().unwrap();
     let query = MotionQuery {
