@@ -126,3 +126,27 @@ fn an_infeasible_plan_fails_the_same_way_under_load() {
         },
     );
 }
+
+#[test]
+fn a_request_time_limit_running_out_is_time_limit_not_timeout() {
+    // Only a request that sets a wall-clock limit can get it; the code is its
+    // own (`timeout` means a component did not answer).
+    let p = setup("can_waist");
+    let hopeless = PlanOptions {
+        delta_f: Some(1000.0),
+        max_samples: 1_000_000,
+        max_candidates: 1000,
+        time_budget_ms: Some(1),
+        ..PlanOptions::default()
+    };
+    let e = p
+        .plan(&hopeless, &AtomicBool::new(false), &mut |_| {})
+        .unwrap_err();
+    let wire = e.to_call_error();
+    assert_eq!(wire.code, "time_limit", "{}", wire.message);
+    assert!(
+        wire.details_json.contains("out_of_time"),
+        "{}",
+        wire.details_json
+    );
+}
