@@ -50,3 +50,43 @@ fn plugins_lists_what_a_running_host_serves() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("no_plugin"), "{stderr}");
 }
+
+#[test]
+fn view_draws_a_scene_headless_and_names_bad_arguments() {
+    let dir = std::env::temp_dir().join(format!("tsukami-view-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = tsukami_e2e::models_dir().join("scenes/can_breast.toml");
+    let view = |extra: &[&str]| {
+        let mut args = vec!["view", "--scene", scene.to_str().unwrap()];
+        args.extend(extra);
+        std::process::Command::new(tsukami_exe())
+            .args(&args)
+            .output()
+            .unwrap()
+    };
+    let (png, glb) = (dir.join("scene.png"), dir.join("scene.glb"));
+    let out = view(&[
+        "--out",
+        png.to_str().unwrap(),
+        "--glb",
+        glb.to_str().unwrap(),
+        "--size",
+        "320x240",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let picture = std::fs::read(&png).unwrap();
+    assert_eq!(&picture[..8], b"\x89PNG\r\n\x1a\n");
+    // IHDR: width and height, big-endian, right after the chunk's length and type.
+    assert_eq!(&picture[16..24], &[0, 0, 1, 64, 0, 0, 0, 240]);
+    assert_eq!(&std::fs::read(&glb).unwrap()[..4], b"glTF");
+    for (extra, named) in [
+        (&["--out", "x.png", "--size", "0x5"][..], "--size"),
+        (&["--out", "x.png", "--eye", "1,2"][..], "--eye"),
+        (&["--out", "x.png", "--result", "/nonexistent/reply.json"][..], "result"),
+    ] {
+        let out = view(extra);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && stderr.contains(named), "{extra:?}: {stderr}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -39,8 +39,9 @@ impl Rgba {
     pub const HAND: Rgba = Rgba([0.95, 0.55, 0.12, 1.0]);
     /// The object to grasp.
     pub const OBJECT: Rgba = Rgba([0.12, 0.42, 0.95, 1.0]);
-    /// Tables, shelves and other obstacles.
-    pub const OBSTACLE: Rgba = Rgba([0.55, 0.42, 0.28, 1.0]);
+    /// Tables, shelves and other obstacles: see-through, so a fridge's walls
+    /// do not hide the grasp inside.
+    pub const OBSTACLE: Rgba = Rgba([0.55, 0.42, 0.28, 0.4]);
     /// Contact markers.
     pub const CONTACT: Rgba = Rgba([0.95, 0.08, 0.08, 1.0]);
     /// Friction cones (translucent).

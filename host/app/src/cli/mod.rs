@@ -6,6 +6,7 @@ mod fc_problem;
 mod fc_solve;
 mod model;
 mod model_report;
+mod view;
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
@@ -112,6 +113,9 @@ enum Command {
     Plan(Payload),
     /// Stop: cancel the planner's running call.
     Stop,
+    /// Motion: plan a trajectory from the start to a grasp (`<ns>/motion/plan`;
+    /// `{"grasp": <a Plan reply>, "seed"?, "start"?, "lift_height"?}`).
+    Motion(Payload),
     /// Run a zenoh router on loopback until interrupted: the host, the components and
     /// the clients connect to it (`mode: "client"`) instead of to each other.
     Router {
@@ -134,6 +138,9 @@ enum Command {
     },
     /// Force-closure tests and grasp quality of contact sets (JSON in, JSON out).
     Fc(fc::FcArgs),
+    /// Draw a scene and a planned grasp: a PNG picture and optionally a glTF
+    /// binary, headless (`--scene models/scenes/can_breast.toml --result reply.json`).
+    View(view::ViewArgs),
 }
 
 /// Runs the CLI and maps errors to a message and exit status 1.
@@ -173,11 +180,13 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::RemoveEnv(p) => planner(keys::planner::REMOVE_ENV, p),
         Command::Plan(p) => planner(keys::planner::PLAN, p),
         Command::Stop => send(&cli.bus, ROLE_GRASP_PLANNER, keys::STOP, b""),
+        Command::Motion(p) => send(&cli.bus, keys::ROLE_TRAJECTORY_PLANNER, "plan", &p.bytes()?),
         Command::Router { listen } => route(listen, &cli.bus),
         Command::Schema { out } => write_schema(out),
         Command::Demo(args) => tsukami::demo::run(args),
         Command::Model { command } => model::run(command).map(|()| ExitCode::SUCCESS),
         Command::Fc(args) => fc::run(args).map(|()| ExitCode::SUCCESS),
+        Command::View(args) => view::run(args).map(|()| ExitCode::SUCCESS),
     }
 }
 
