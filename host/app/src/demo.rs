@@ -10,6 +10,7 @@ use crate::config::{default_models_dir, HostConfig};
 use crate::scenes::{run_scene, SceneOutcome};
 use crate::server::RunningHost;
 use anyhow::{bail, Result};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use tsukami_scenes::PAPER_SCENES;
@@ -26,7 +27,14 @@ pub struct DemoArgs {
     /// Print a JSON array of `{"scene", "expected", "ok", "result"}` instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Folder of the report: `report.md`, and per scene a picture (`SCENE.png`)
+    /// and a glTF binary (`SCENE.glb`). Default: `target/demo-report`.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }
+
+/// Where the report goes without `--out`.
+pub const DEFAULT_REPORT_DIR: &str = "target/demo-report";
 
 /// Runs the demo.
 pub fn run(args: &DemoArgs) -> Result<ExitCode> {
@@ -80,6 +88,14 @@ pub fn run(args: &DemoArgs) -> Result<ExitCode> {
     }
     client.close();
     host.shutdown();
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_REPORT_DIR));
+    let report = crate::demo_report::write_report(&out, &models, &outcomes, args.seed)?;
+    if !args.json {
+        println!("\nReport, pictures and .glb files: {}", report.display());
+    }
     let all_ok = outcomes.iter().all(|o| o.ok);
     Ok(if all_ok {
         ExitCode::SUCCESS
@@ -88,39 +104,43 @@ pub fn run(args: &DemoArgs) -> Result<ExitCode> {
     })
 }
 
+/// One scene's table cells: grasp type, OCP region and face, whole-body
+/// joints, margin, and the independent check's verdict with the weight.
+pub(crate) fn cells(o: &SceneOutcome) -> [String; 5] {
+    let Some(r) = &o.result else {
+        return ["-", "-", "-", "-", "-"].map(str::to_owned);
+    };
+    let face = serde_json::to_value(r.face)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_owned))
+        .unwrap_or_default();
+    let joints = if r.joints_used.is_empty() {
+        "arm only".to_owned()
+    } else {
+        r.joints_used.join(",")
+    };
+    // Recomputed by the independent check, never the planner's flag.
+    let exact = match o.weight_scale {
+        Some(s) if s >= 1.0 => "holds",
+        Some(_) => "FAILS",
+        None => "-",
+    };
+    [
+        r.grasp_type.name.clone(),
+        format!("{}:{face}", r.ocp_region),
+        joints,
+        format!("{:.3}", r.force_closure.margin),
+        exact.to_owned(),
+    ]
+}
+
 fn print_table(outcomes: &[SceneOutcome]) {
     println!(
         "{:<11} {:<16} {:<6} {:<31} {:>7} {:>6} {:>9}  paper",
         "scene", "grasp type", "face", "whole-body joints", "margin", "exact", "plan ms"
     );
     for o in outcomes {
-        let (grasp, face, joints, margin, exact) = match &o.result {
-            Some(r) => (
-                r.grasp_type.name.clone(),
-                format!(
-                    "{}:{}",
-                    r.ocp_region,
-                    serde_json::to_value(r.face)
-                        .ok()
-                        .and_then(|v| v.as_str().map(str::to_owned))
-                        .unwrap_or_default()
-                ),
-                if r.joints_used.is_empty() {
-                    "arm only".to_owned()
-                } else {
-                    r.joints_used.join(",")
-                },
-                format!("{:.3}", r.force_closure.margin),
-                // Recomputed by the independent check, never the planner's flag.
-                match o.weight_scale {
-                    Some(s) if s >= 1.0 => "holds",
-                    Some(_) => "FAILS",
-                    None => "-",
-                }
-                .to_owned(),
-            ),
-            None => ("-".into(), "-".into(), "-".into(), "-".into(), "-".into()),
-        };
+        let [grasp, face, joints, margin, exact] = cells(o);
         let verdict = if o.ok { "ok" } else { "DIFFERS" };
         println!(
             "{:<11} {:<16} {:<6} {:<31} {:>7} {:>6} {:>9.1}  {verdict}: {}",

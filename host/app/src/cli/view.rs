@@ -9,11 +9,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use nalgebra::{Point3, Vector3};
+use nalgebra::Vector3;
+use tsukami::picture::{write_pictures, DEFAULT_EYE};
 use tsukami_msgs::planner::PlanReply;
-use tsukami_result_viewer::glb::to_glb;
-use tsukami_result_viewer::grasp_view::{contact_marks, posture, GraspView};
-use tsukami_result_viewer::render::{render, Camera};
 use tsukami_scenes::{scene_requests, World};
 
 /// Largest picture edge (pixels).
@@ -38,15 +36,19 @@ pub struct ViewArgs {
     #[arg(long, default_value = "800x600")]
     size: String,
     /// Camera position relative to the object (m, world frame), `x,y,z`; it
-    /// looks at the object.
-    #[arg(long, default_value = "0.15,-0.55,0.25", allow_hyphen_values = true)]
-    eye: String,
+    /// looks at the object. Default: to the robot's right, in front, above
+    /// (`tsukami::picture::DEFAULT_EYE`).
+    #[arg(long, allow_hyphen_values = true)]
+    eye: Option<String>,
 }
 
 /// Runs `tsukami view`.
 pub fn run(args: &ViewArgs) -> Result<()> {
     let (width, height) = size(&args.size)?;
-    let eye = eye(&args.eye)?;
+    let eye = match &args.eye {
+        Some(text) => eye(text)?,
+        None => Vector3::from(DEFAULT_EYE),
+    };
     let scene = std::fs::canonicalize(&args.scene)
         .with_context(|| format!("scene {}", args.scene.display()))?;
     let models = scene
@@ -66,32 +68,16 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         }
         None => None,
     };
-    let q = match &reply {
-        Some(r) => posture(&world.robot.model, r).map_err(|e| anyhow::anyhow!("result: {e}"))?,
-        None => world.robot.model.rest_positions(),
-    };
-    let contacts = reply.as_ref().map(contact_marks).unwrap_or_default();
-    let drawing = GraspView {
-        model: &world.robot.model,
-        collision: &world.robot.collision,
-        q: &q,
-        hand_links: &world.robot.hand_links,
-        object: Some((&world.object.mesh, world.object.pose)),
-        obstacles: &world.obstacles,
-        contacts: &contacts,
-    }
-    .drawing();
-    let target = Point3::from(world.object.pose.translation.vector);
-    let camera = Camera::looking_at(target + eye, target, Vector3::z());
-    let png = render(&drawing, &camera, width, height).to_png()?;
-    std::fs::write(&args.out, png).with_context(|| format!("writing {}", args.out.display()))?;
-    if let Some(path) = &args.glb {
-        std::fs::write(path, to_glb(&drawing))
-            .with_context(|| format!("writing {}", path.display()))?;
-    }
+    let triangles = write_pictures(
+        &world,
+        reply.as_ref(),
+        &args.out,
+        args.glb.as_deref(),
+        (width, height),
+        eye,
+    )?;
     eprintln!(
-        "tsukami: {} triangles drawn to {}",
-        drawing.triangle_count(),
+        "tsukami: {triangles} triangles drawn to {}",
         args.out.display()
     );
     Ok(())

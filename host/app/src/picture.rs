@@ -1,0 +1,92 @@
+//! Pictures of a scene and its planned grasp, for `tsukami view` and the
+//! demo's report: a PNG from the result viewer's software renderer and,
+//! optionally, the same drawing as a glTF binary.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use nalgebra::{Point3, Vector3};
+use tsukami_msgs::planner::PlanReply;
+use tsukami_result_viewer::drawing::Drawing;
+use tsukami_result_viewer::glb::to_glb;
+use tsukami_result_viewer::grasp_view::{contact_marks, posture, GraspView};
+use tsukami_result_viewer::render::{render, Camera};
+use tsukami_scenes::World;
+
+/// Where the camera sits relative to the object by default (m, world frame):
+/// to the robot's right, in front, a little above.
+pub const DEFAULT_EYE: [f64; 3] = [0.15, -0.55, 0.25];
+
+/// The drawing of `world` with the robot at `reply`'s posture and its
+/// contacts, or at rest without a reply.
+pub fn scene_drawing(world: &World, reply: Option<&PlanReply>) -> Result<Drawing> {
+    let q = match reply {
+        Some(r) => posture(&world.robot.model, r).map_err(|e| anyhow::anyhow!("result: {e}"))?,
+        None => world.robot.model.rest_positions(),
+    };
+    let contacts = reply.map(contact_marks).unwrap_or_default();
+    Ok(GraspView {
+        model: &world.robot.model,
+        collision: &world.robot.collision,
+        q: &q,
+        hand_links: &world.robot.hand_links,
+        object: Some((&world.object.mesh, world.object.pose)),
+        obstacles: &world.obstacles,
+        contacts: &contacts,
+    }
+    .drawing())
+}
+
+/// What the camera looks at: midway between the object's box centre and the
+/// contacts' centroid (the object's box centre without a grasp).
+fn look_at(world: &World, reply: Option<&PlanReply>) -> Point3<f64> {
+    let points = &world.object.mesh.vertices;
+    let (lo, hi) = points.iter().fold(
+        (
+            Point3::from([f64::INFINITY; 3]),
+            Point3::from([f64::NEG_INFINITY; 3]),
+        ),
+        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+    );
+    let center = world.object.pose * nalgebra::center(&lo, &hi);
+    let contacts: Vec<Point3<f64>> = reply
+        .map(|r| {
+            r.contacts
+                .iter()
+                .map(|c| Point3::from(c.position))
+                .collect()
+        })
+        .unwrap_or_default();
+    if contacts.is_empty() || !center.coords.iter().all(|c| c.is_finite()) {
+        return if center.coords.iter().all(|c| c.is_finite()) {
+            center
+        } else {
+            Point3::from(world.object.pose.translation.vector)
+        };
+    }
+    let centroid =
+        contacts.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / contacts.len() as f64;
+    Point3::from((center.coords + centroid) / 2.0)
+}
+
+/// Draws `world` (and `reply`) to a `size` PNG at `png` seen from `eye`
+/// relative to the grasp (see `look_at`), and to `glb` when given. Returns the triangles drawn.
+pub fn write_pictures(
+    world: &World,
+    reply: Option<&PlanReply>,
+    png: &Path,
+    glb: Option<&Path>,
+    size: (u32, u32),
+    eye: Vector3<f64>,
+) -> Result<usize> {
+    let drawing = scene_drawing(world, reply)?;
+    let target = look_at(world, reply);
+    let camera = Camera::looking_at(target + eye, target, Vector3::z());
+    let picture = render(&drawing, &camera, size.0, size.1).to_png()?;
+    std::fs::write(png, picture).with_context(|| format!("writing {}", png.display()))?;
+    if let Some(path) = glb {
+        std::fs::write(path, to_glb(&drawing))
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(drawing.triangle_count())
+}
