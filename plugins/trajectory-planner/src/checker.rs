@@ -20,7 +20,10 @@
 //! phases: [`ObjectRule`] (the object to grasp, which some hand links may touch
 //! up to a depth while the hand closes on it) and [`Attached`] (the grasped object
 //! moving with the hand, checked against the obstacles and the rest of the robot).
-//! [`RobotWorld::first_hit`] names what collides. Every check is counted.
+//! [`RobotWorld::first_hit`] names what collides. The first check of a world
+//! covers every link; later ones only the links the planned joints move (the
+//! others keep the pose the first check saw), and only link pairs one of which
+//! moves. Every check is counted.
 
 use nalgebra::{Isometry3, Vector3};
 use tsukami_body::collision::{CollisionObject, RobotCollision};
@@ -38,8 +41,13 @@ pub const DEFAULT_MAX_TRAVEL: f64 = 0.005;
 pub struct RobotWorld<'a> {
     model: &'a RobotModel,
     collision: &'a RobotCollision,
+    /// `collision` with the pairs of links the planned joints never move
+    /// relative to each other allowed: every check after the first.
+    moving_pairs: RobotCollision,
     obstacles: Vec<&'a CollisionObject>,
     links: Vec<LinkId>,
+    /// Links with geometry that the planned joints move.
+    moving: Vec<LinkId>,
     joints: Vec<JointId>,
     base: Vec<f64>,
     margin: f64,
@@ -112,14 +120,26 @@ impl<'a> RobotWorld<'a> {
         base: Vec<f64>,
         margin: f64,
     ) -> Self {
-        let links = (0..model.links.len())
+        let links: Vec<LinkId> = (0..model.links.len())
             .filter(|&l| !collision.link_parts(l).is_empty())
             .collect();
+        let moved = moved_links(model, &joints);
+        let moving = links.iter().copied().filter(|&l| moved[l]).collect();
+        let mut moving_pairs = collision.clone();
+        for &a in &links {
+            for &b in &links {
+                if !moved[a] && !moved[b] {
+                    moving_pairs.allow(a, b);
+                }
+            }
+        }
         RobotWorld {
             model,
             collision,
+            moving_pairs,
             obstacles,
             links,
+            moving,
             joints,
             scratch: base.clone(),
             base,
@@ -218,15 +238,21 @@ impl RobotWorld<'_> {
         self.model.apply_mimics(&mut self.scratch);
         self.model.forward_kinematics(&self.scratch, &mut self.fk);
         let name = |l: LinkId| self.model.links[l].name.clone();
-        if let Some((a, b)) = self.collision.first_self_collision(&self.fk, self.margin) {
+        // Links the planned joints do not move stay where the first check saw them.
+        let (pairs, links) = if self.checks == 1 {
+            (self.collision, &self.links)
+        } else {
+            (&self.moving_pairs, &self.moving)
+        };
+        if let Some((a, b)) = pairs.first_self_collision(&self.fk, self.margin) {
             return Some(Collision {
                 link: name(a),
                 with: format!("link `{}`", name(b)),
             });
         }
-        if let Some(hit) =
-            self.collision
-                .first_collision(&self.fk, &self.links, &self.obstacles, self.margin)
+        if let Some(hit) = self
+            .collision
+            .first_collision(&self.fk, links, &self.obstacles, self.margin)
         {
             return Some(Collision {
                 link: name(hit.link),
@@ -239,8 +265,8 @@ impl RobotWorld<'_> {
     fn object_hit(&self) -> Option<Collision> {
         let rule = self.object.as_ref()?;
         let name = |l: LinkId| self.model.links[l].name.clone();
-        let strict: Vec<LinkId> = self
-            .links
+        let links = if self.checks == 1 { &self.links } else { &self.moving };
+        let strict: Vec<LinkId> = links
             .iter()
             .copied()
             .filter(|l| !rule.touching.contains(l))
@@ -274,6 +300,7 @@ impl RobotWorld<'_> {
                 });
             }
         }
+        // The carried object moves: every link but the hand's, every check.
         let links: Vec<LinkId> = self
             .links
             .iter()
@@ -294,6 +321,23 @@ impl Validity for RobotWorld<'_> {
     fn is_valid(&mut self, q: &[f64]) -> bool {
         self.first_hit(q).is_none()
     }
+}
+
+/// Per link: does a planned joint (or a mimic joint following one) move it?
+fn moved_links(model: &RobotModel, joints: &[JointId]) -> Vec<bool> {
+    let mut moved = vec![false; model.links.len()];
+    // Links are stored parents first: a link moves when its parent does or when
+    // its own joint is planned or mimics a planned joint.
+    for l in 1..model.links.len() {
+        let Some(j) = model.links[l].parent_joint else {
+            continue;
+        };
+        let joint = &model.joints[j];
+        let driven = joints.contains(&j)
+            || joint.mimic.as_ref().is_some_and(|m| joints.contains(&m.master));
+        moved[l] = moved[joint.parent] || driven;
+    }
+    moved
 }
 
 /// The segment resolution of a [`RobotWorld`], as a value of its own so that a

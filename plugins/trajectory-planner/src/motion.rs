@@ -73,7 +73,7 @@ impl Default for MotionConfig {
             sample_dt: 0.05,
             max_travel: DEFAULT_MAX_TRAVEL,
             touch_tolerance: 0.001,
-            shortcut_attempts: 100,
+            shortcut_attempts: 50,
             rrt_step: 0.15,
             line_step: 0.005,
             support_clearance: 0.002,
