@@ -63,16 +63,19 @@ fn size_class(object: &Object) -> GraspSize {
     }
 }
 
+/// What `tsukami plugins` shows for this planner.
+const INFO: PlannerInfo = PlannerInfo {
+    name: "tsukami-antipodal-planner",
+    version: env!("CARGO_PKG_VERSION"),
+    description: "example planner: antipodal fingertip pinch, whole-body IK",
+};
+
 impl GraspPlanner for Antipodal {
     type RobotData = Pinch;
     type ObjectData = Vec<f64>;
 
     fn info() -> PlannerInfo {
-        PlannerInfo {
-            name: "tsukami-antipodal-planner",
-            version: env!("CARGO_PKG_VERSION"),
-            description: "example planner: antipodal fingertip pinch, whole-body IK",
-        }
+        INFO
     }
 
     fn new(_config: &PlannerConfig) -> Result<Self, String> {
@@ -87,12 +90,7 @@ impl GraspPlanner for Antipodal {
         Ok(surface::cumulative_areas(&object.mesh))
     }
 
-    fn plan(
-        &self,
-        w: &World<'_, Self>,
-        opts: &PlanOptions,
-        run: &mut Run,
-    ) -> Result<Grasp, NoGrasp> {
+    fn plan(&self, w: &World<'_, Self>, o: &PlanOptions, run: &mut Run) -> Result<Grasp, NoGrasp> {
         let size = size_class(w.object);
         let gt = GraspTypeRef {
             name: format!("fingertip3_{}", size.as_str()),
@@ -107,7 +105,7 @@ impl GraspPlanner for Antipodal {
             .pose(robot.model.joints[hand.arm[0]].child)
             .translation
             .vector;
-        let rng = ChaCha8Rng::seed_from_u64(opts.seed);
+        let rng = ChaCha8Rng::seed_from_u64(o.seed);
         let mut s = Sample {
             w,
             fk,
@@ -115,7 +113,7 @@ impl GraspPlanner for Antipodal {
             shoulder,
             rng,
         };
-        let stages = robot.stages(hand, opts.whole_body);
+        let stages = robot.stages(hand, o.whole_body);
         for (si, stage) in stages.iter().enumerate() {
             run.tried(&gt.name);
             run.phase(
@@ -127,11 +125,11 @@ impl GraspPlanner for Antipodal {
                 robot,
                 hand,
                 stage,
-                palm_ik(2, opts.seed.wrapping_add(si as u64)),
+                palm_ik(2, o.seed.wrapping_add(si as u64)),
             ) else {
                 continue;
             };
-            for k in 0..opts.max_samples {
+            for k in 0..o.max_samples {
                 run.sample()?;
                 if k % 16 == 15 {
                     run.report();
