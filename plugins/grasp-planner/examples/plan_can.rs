@@ -15,7 +15,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all(&dir)?;
     let path = dir.join("cyl.stl");
     tsukami_body::mesh::TriangleMesh::cylinder(r, h, 32).write_stl(&path)?;
-    let mut p = Planner::new("models");
+    let p = Planner::new("models");
     p.set_robot(&SetRobot {
         robot: "tsukami_humanoid".into(),
         grasp_types: None,

@@ -6,14 +6,14 @@ use {tsukami_grasp_planner::planner::Planner, tsukami_scenes::scene_requests};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let path = std::path::Path::new(args.first().ok_or("usage: plan_scene SCENE.toml [SEED]")?);
+    let path = &std::fs::canonicalize(args.first().ok_or("usage: plan_scene SCENE.toml [SEED]")?)?;
     let seed = args.get(1).map(|s| s.parse()).transpose()?.unwrap_or(0);
     let req = scene_requests(path)?;
     let models = path
         .parent()
         .and_then(|p| p.parent())
         .ok_or("scene must be in models/scenes")?;
-    let mut p = Planner::new(models);
+    let p = Planner::new(models);
     p.set_robot(&req.robot)?;
     let obj = p.set_object(&req.object)?;
     eprintln!(
