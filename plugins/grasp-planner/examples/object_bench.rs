@@ -7,10 +7,12 @@
 //! object or an obstacle, joint limits, palm pose). Prints the planned and
 //! verified rates per family and placement, plan time p50/p95/p99, the reasons
 //! of every failure, and the mesh-size figures: SetObject and plan p50 on the
-//! same sphere with 1k, 100k and 1M triangles, and their ratios.
+//! same can with 1k, 100k and 1M triangles, and their ratios.
 //!
 //! Run in release: `cargo run --release -p tsukami-grasp-planner --example
-//! object_bench [-- --seed N] [-- --quick]` (`--quick` skips the 1M mesh).
+//! object_bench [-- --seed N] [--quick] [--sizes] [--only TEXT]` (`--quick`
+//! skips the 1M mesh, `--sizes` runs only the size figures, `--only` the cases
+//! whose object or placement name contains TEXT, with details).
 //! Meshes are written as binary STL files to a temporary model root and loaded
 //! through `set_object` like a user's, then removed.
 
@@ -21,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use objects::{objects, placements, set_env, set_object, sphere_with, BenchObject, Placement};
+use objects::{can_with, objects, placements, set_env, set_object, BenchObject, Placement};
 use serde_json::{json, Value};
 use tsukami_grasp_planner::planner::Planner;
 use tsukami_msgs::planner::{PlanOptions, PlanReply, SetEnv, SetObject, SetRobot};
@@ -176,24 +178,24 @@ fn report(outcomes: &[Outcome]) {
 
 /// SetObject (median of `reps`) and plan p50 (over `seeds`) of one mesh file.
 fn size_figures(planner: &Planner, path: &str, reps: usize, seeds: u64) -> (f64, f64, usize) {
-    let p = &placements()[0];
+    let p = &placements()[1];
     let env: SetEnv = parse(set_env(p));
     planner.set_env(&env).unwrap();
-    let sphere = BenchObject {
-        name: "sphere".into(),
-        family: "sphere",
-        mesh: sphere_with(1000, 0.035),
+    let can = BenchObject {
+        name: "can".into(),
+        family: "can",
+        mesh: can_with(1000),
         mass: 0.15,
         flat: false,
     };
-    let req: SetObject = parse(set_object(&sphere, p, path));
+    let req: SetObject = parse(set_object(&can, p, path));
     let mut set = Vec::new();
     let mut triangles = 0;
     for _ in 0..reps {
         let t = Instant::now();
         triangles = planner
             .set_object(&req)
-            .expect("the sphere loads")
+            .expect("the can loads")
             .triangles;
         set.push(t.elapsed().as_secs_f64() * 1e3);
     }
@@ -208,7 +210,7 @@ fn size_figures(planner: &Planner, path: &str, reps: usize, seeds: u64) -> (f64,
         let r = planner.plan(&opts, &AtomicBool::new(false), &mut |_| {});
         plan.push(t.elapsed().as_secs_f64() * 1e3);
         if let Err(e) = r {
-            println!("  (sphere seed {seed}: {e})");
+            println!("  (can seed {seed}: {e})");
         }
     }
     plan.sort_by(f64::total_cmp);
@@ -232,6 +234,8 @@ fn main() {
         .cloned()
         .unwrap_or_default();
     let verbose = !only.is_empty();
+    // `--sizes`: only the mesh-size figures.
+    let sizes_only = args.iter().any(|a| a == "--sizes");
     let tmp = std::env::temp_dir().join(format!("tsukami-object-bench-{}", std::process::id()));
     std::fs::create_dir_all(&tmp).unwrap();
     let root = std::fs::canonicalize(&tmp).unwrap();
@@ -254,7 +258,7 @@ fn main() {
         objs.len() * places.len()
     );
     let mut outcomes = Vec::new();
-    for o in &objs {
+    for o in objs.iter().filter(|_| !sizes_only) {
         let path = root.join(format!("{}.stl", o.name));
         o.mesh.write_stl(&path).unwrap();
         let path = path.display().to_string();
@@ -272,12 +276,14 @@ fn main() {
             outcomes.push(out);
         }
     }
-    report(&outcomes);
+    if !sizes_only {
+        report(&outcomes);
+    }
     if verbose {
         return;
     }
 
-    println!("\nmesh size (same sphere, r = 35 mm, on the 0.78 m table; SetObject median of 5, plan p50 of 10 seeds):");
+    println!("\nmesh size (the same 350 ml can, on the rotated 1.00 m counter; SetObject median of 5, plan p50 of 10 seeds):");
     let mut figures = Vec::new();
     let sizes: &[usize] = if quick {
         &[1_000, 100_000]
@@ -285,8 +291,8 @@ fn main() {
         &[1_000, 100_000, 1_000_000]
     };
     for &n in sizes {
-        let path = root.join(format!("sphere_{n}.stl"));
-        sphere_with(n, 0.035).write_stl(&path).unwrap();
+        let path = root.join(format!("can_{n}.stl"));
+        can_with(n).write_stl(&path).unwrap();
         let (reps, seeds) = if n >= 1_000_000 { (2, 3) } else { (5, 10) };
         let (set_ms, plan_ms, tris) =
             size_figures(&planner, &path.display().to_string(), reps, seeds);

@@ -399,6 +399,17 @@ pub fn set_env(p: &Placement) -> Value {
     json!({"obstacles": p.obstacles, "replace": true})
 }
 
+/// A 350 ml can (r = 33 mm, h = 122 mm) of about `triangles` triangles: rings
+/// every few millimetres like a scan's (for the size figures).
+pub fn can_with(triangles: usize) -> TriangleMesh {
+    let segments = ((triangles as f64).sqrt() * 1.0).round().max(8.0) as usize;
+    let bands = (triangles / (2 * segments)).saturating_sub(1).max(1);
+    let profile: Vec<(f64, f64)> = (0..=bands)
+        .map(|k| (0.033, 0.122 * k as f64 / bands as f64))
+        .collect();
+    TriangleMesh::lathe(&profile, segments)
+}
+
 /// A sphere of about `triangles` triangles (for the size figures).
 pub fn sphere_with(triangles: usize, r: f64) -> TriangleMesh {
     let rings = ((triangles as f64 / 4.0).sqrt().floor() + 1.0).max(3.0) as usize;
