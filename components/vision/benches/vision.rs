@@ -66,6 +66,13 @@ fn run(det: &mut Detector, object: &str, trials: &[Trial]) -> Row {
     row
 }
 
+fn cond_of(occ: Option<&str>) -> String {
+    match occ {
+        None => "alone".to_string(),
+        Some(o) => format!("+{o} 30% occl"),
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let trials_n: usize = args
@@ -86,7 +93,16 @@ fn main() {
     let mut p2p_params = DetectParams::default();
     p2p_params.coarse.mode = IcpMode::PointToPoint;
     p2p_params.fine.mode = IcpMode::PointToPoint;
-    let mut p2p = Detector::new(roots, p2p_params);
+    let mut p2p = Detector::new(roots.clone(), p2p_params);
+    // The pipeline before resting-pose hypotheses and cluster unions
+    // (2026-11-30), for the same images.
+    let before_params = DetectParams {
+        resting_hypotheses: false,
+        merge_pairs: false,
+        ..DetectParams::default()
+    };
+    let mut before = Detector::new(roots, before_params);
+    let mut before_rows = Vec::new();
 
     println!("vision accuracy: {trials_n} random resting poses per object and condition, 640x480, 1 mm noise");
     println!(
@@ -123,10 +139,7 @@ fn main() {
             let render_s = render_start.elapsed().as_secs_f64();
             let mut row = run(&mut det, target, &trials);
             let occl = trials.iter().map(|t| t.occluded).sum::<f64>() / trials.len() as f64;
-            let cond = match occ {
-                None => "alone".to_string(),
-                Some(o) => format!("+{o} 30% occl"),
-            };
+            let cond = cond_of(occ);
             println!(
                 "{:<10} {:<16} {:>3}/{:<2} {:>5}/{:<2} {:>6.2} mm {:>5.2} mm {:>7.2}° {:>6.2}° {:>7.0}% {:>8.1} {:>8.1}   (render {:.1} s)",
                 target,
@@ -156,6 +169,15 @@ fn main() {
                 pct(&mut alt.ms, 0.5),
                 pct(&mut row.ms, 0.5),
             ));
+            let mut old = run(&mut before, target, &trials);
+            before_rows.push((
+                target.to_string(),
+                cond_of(occ),
+                old.within,
+                trials.len(),
+                pct(&mut old.ms, 0.5),
+                pct(&mut row.ms, 0.5),
+            ));
             if occ.is_none() {
                 alone_trials.push((target.to_string(), trials));
             }
@@ -174,6 +196,14 @@ fn main() {
         println!(
             "{t:<10} {c:<16} within {within:>2}/{n:<2}  pos p50 {pos:>6.2} mm  rot p50 {rot:>6.2}°  ms p50 {ms:>6.1}  (point-to-plane/point-to-point time {:.2}x)",
             ms_plane / ms
+        );
+    }
+
+    println!("\nalternative: the pipeline without resting-pose hypotheses and cluster unions, same images");
+    for (t, c, within, n, ms, ms_now) in &before_rows {
+        println!(
+            "{t:<10} {c:<16} within {within:>2}/{n:<2}  ms p50 {ms:>6.1}  (now/before time {:.2}x)",
+            ms_now / ms
         );
     }
 

@@ -10,8 +10,11 @@
 //! How: back-project every `stride`-th pixel, remove the large horizontal
 //! planes (RANSAC), cluster the rest on the pixel grid (and split each cluster
 //! again with a smaller gap, since an occluder close in front of the target
-//! joins it), keep pieces no larger than the object; for each, try every principal-axis hypothesis with a short
-//! coarse ICP, refine the best two with a full ICP, then gather the
+//! joins it), add the unions of two clusters that together are no larger than
+//! the object (an occluder in front can cut the target in two), keep pieces no
+//! larger than the object; for each, try every principal-axis hypothesis and
+//! every resting pose on the plane under it ([`crate::resting`]) with a short
+//! coarse ICP, refine the best few with a full ICP, then gather the
 //! full-resolution points around the fitted model and refine once more; the
 //! candidate with the highest verified confidence wins, reported in its
 //! symmetry class's canonical form.
@@ -31,6 +34,7 @@ use crate::error::{invalid, Result};
 use crate::hypotheses::from_principal_axes;
 use crate::icp::{refine, IcpFit, IcpParams};
 use crate::plane::{find_planes, FoundPlane, PlaneParams};
+use crate::resting::on_plane;
 use crate::template::ObjectTemplate;
 use crate::verify::{verify, Verdict, VerifyParams};
 
@@ -43,6 +47,9 @@ pub struct DetectParams {
     pub plane: PlaneParams,
     /// Largest 3-D gap inside a cluster (m).
     pub cluster_gap: f64,
+    /// Each cluster is split again with these fractions of `cluster_gap`,
+    /// each split's pieces candidates of their own.
+    pub split_gaps: Vec<f64>,
     /// Smallest cluster (points of the strided cloud).
     pub min_cluster_points: usize,
     /// Most clusters examined (largest first).
@@ -65,6 +72,10 @@ pub struct DetectParams {
     pub max_fine: usize,
     /// Stop examining fine fits once one reaches this confidence.
     pub early_accept: f64,
+    /// Also start from the model's resting poses on the plane under a segment.
+    pub resting_hypotheses: bool,
+    /// Also try the union of two clusters no larger than the object together.
+    pub merge_pairs: bool,
     /// Report only poses resting on a found plane (within the two limits below).
     pub require_support: bool,
     /// Deepest a model may sink into the plane under it (m).
@@ -83,6 +94,7 @@ impl Default for DetectParams {
             stride: 2,
             plane: PlaneParams::default(),
             cluster_gap: 0.012,
+            split_gaps: vec![0.6],
             min_cluster_points: 25,
             max_clusters: 6,
             coarse: IcpParams {
@@ -104,6 +116,8 @@ impl Default for DetectParams {
             verify: VerifyParams::default(),
             max_fine: 4,
             early_accept: 0.9,
+            resting_hypotheses: true,
+            merge_pairs: true,
             require_support: true,
             max_penetration: 0.01,
             max_rest_gap: 0.02,
@@ -226,10 +240,13 @@ pub fn detect_with(
     }
     let planes = find_planes(&cloud.points, &params.plane);
     let size_limit = template.radius * 1.25 + 0.01;
-    let (clusters, pieces) = segment(&cloud, &planes, image.width(), params);
+    let (mut clusters, mut pieces) = segment(&cloud, &planes, image.width(), params);
+    if params.merge_pairs {
+        add_unions(&mut clusters, &mut pieces, size_limit);
+    }
     let segments = candidate_sets(&pieces, size_limit);
     let t_segment = started.elapsed();
-    let coarse = coarse_fits(template, &segments, &camera.centre(), params);
+    let coarse = coarse_fits(template, &segments, &planes, &camera.centre(), params);
     let t_coarse = started.elapsed();
     let best = best_fine(
         template, &segments, &clusters, &coarse, image, camera, &planes, params,
@@ -295,6 +312,7 @@ fn explain(v: &Verdict, min_confidence: f64) -> String {
 fn coarse_fits(
     template: &ObjectTemplate,
     segments: &[&Segment],
+    planes: &[FoundPlane],
     cam: &Point3<f64>,
     params: &DetectParams,
 ) -> Vec<(f64, usize, IcpFit)> {
@@ -304,7 +322,13 @@ fn coarse_fits(
             continue;
         };
         let pts = thin(&seg.points, params.coarse_points);
-        let mut fits: Vec<(f64, usize, IcpFit)> = from_principal_axes(template, &m, cam)
+        let mut starts = from_principal_axes(template, &m, cam);
+        if params.resting_hypotheses {
+            if let Some(plane) = plane_below(planes, &m.centroid) {
+                starts.extend(on_plane(template, &seg.points, &plane.plane, cam));
+            }
+        }
+        let mut fits: Vec<(f64, usize, IcpFit)> = starts
             .into_iter()
             .map(|h| {
                 let f = refine(template, &pts, Some(*cam), h, &params.coarse);
@@ -359,6 +383,14 @@ fn best_fine(
     best
 }
 
+/// The nearest plane below `p`, if any.
+fn plane_below<'a>(planes: &'a [FoundPlane], p: &Point3<f64>) -> Option<&'a FoundPlane> {
+    planes
+        .iter()
+        .filter(|pl| pl.plane.distance(p) > 0.0)
+        .min_by(|a, b| a.plane.distance(p).total_cmp(&b.plane.distance(p)))
+}
+
 /// A cluster, or a piece of one, and the index of its whole cluster.
 struct Segment {
     points: Vec<Point3<f64>>,
@@ -400,18 +432,12 @@ fn segment(
         .take(params.max_clusters)
         .enumerate()
     {
-        // Split again with a smaller gap: an occluder standing close in front
+        // Split again with smaller gaps: an occluder standing close in front
         // of the target joins it at first.
         let mut sub = vec![None; grid.len()];
         for &i in &parent {
             sub[i] = grid[i];
         }
-        let children = cluster::clusters(
-            &sub,
-            gw,
-            params.cluster_gap * 0.6,
-            params.min_cluster_points,
-        );
         let points =
             |c: &[usize]| -> Vec<Point3<f64>> { c.iter().filter_map(|&i| grid[i]).collect() };
         parents.push(points(&parent));
@@ -419,14 +445,51 @@ fn segment(
             points: points(&parent),
             parent: pi,
         });
-        if children.len() > 1 {
-            out.extend(children.iter().map(|c| Segment {
-                points: points(c),
-                parent: pi,
-            }));
+        for factor in &params.split_gaps {
+            let children = cluster::clusters(
+                &sub,
+                gw,
+                params.cluster_gap * factor,
+                params.min_cluster_points,
+            );
+            if children.len() > 1 {
+                out.extend(children.iter().map(|c| Segment {
+                    points: points(c),
+                    parent: pi,
+                }));
+            }
         }
     }
     (parents, out)
+}
+
+/// Adds, as a cluster and a segment of its own, the union of every two
+/// clusters that together are no larger than the object: an occluder standing
+/// in front of the target can cut what is seen of it in two.
+fn add_unions(clusters: &mut Vec<Vec<Point3<f64>>>, pieces: &mut Vec<Segment>, size_limit: f64) {
+    let n = clusters.len();
+    let centroids: Vec<Option<Point3<f64>>> = clusters
+        .iter()
+        .map(|c| Moments::of(c).map(|m| m.centroid))
+        .collect();
+    for a in 0..n {
+        for b in a + 1..n {
+            let (Some(ca), Some(cb)) = (centroids[a], centroids[b]) else {
+                continue;
+            };
+            if (ca - cb).norm() > 2.0 * size_limit {
+                continue;
+            }
+            let union: Vec<Point3<f64>> = clusters[a].iter().chain(&clusters[b]).copied().collect();
+            if extent(&union) <= size_limit {
+                pieces.push(Segment {
+                    points: union.clone(),
+                    parent: clusters.len(),
+                });
+                clusters.push(union);
+            }
+        }
+    }
 }
 
 /// Largest distance of a point from the centroid (infinite for < 3 points).
@@ -492,11 +555,7 @@ fn rest_gap(
     pose: &Isometry3<f64>,
     planes: &[FoundPlane],
 ) -> Option<f64> {
-    let c = pose * template.moments.centroid;
-    let plane = planes
-        .iter()
-        .filter(|p| p.plane.distance(&c) > 0.0)
-        .min_by(|a, b| a.plane.distance(&c).total_cmp(&b.plane.distance(&c)))?;
+    let plane = plane_below(planes, &(pose * template.moments.centroid))?;
     Some(
         template
             .model

@@ -61,19 +61,29 @@ pub fn from_principal_axes(
     for p in signed_permutations() {
         let r = cluster.axes * p * model.axes.transpose();
         let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r));
-        let probe = Isometry3::from_parts(Translation3::identity(), q);
-        let duplicate = rotations.iter().any(|o| {
-            let other = Isometry3::from_parts(Translation3::identity(), *o);
-            template.symmetry.pose_error(&probe, &other).1 < 5f64.to_radians()
-        });
-        if !duplicate {
-            rotations.push(q);
-        }
+        push_distinct(template, &mut rotations, q);
     }
     rotations
         .into_iter()
         .map(|q| place(template, q, &cluster.centroid, camera))
         .collect()
+}
+
+/// Adds `q` to `rotations` unless one equivalent under the model's symmetry
+/// (within 5°) is there already.
+pub fn push_distinct(
+    template: &ObjectTemplate,
+    rotations: &mut Vec<UnitQuaternion<f64>>,
+    q: UnitQuaternion<f64>,
+) {
+    let probe = Isometry3::from_parts(Translation3::identity(), q);
+    let duplicate = rotations.iter().any(|o| {
+        let other = Isometry3::from_parts(Translation3::identity(), *o);
+        template.symmetry.pose_error(&probe, &other).1 < 5f64.to_radians()
+    });
+    if !duplicate {
+        rotations.push(q);
+    }
 }
 
 /// The pose with rotation `q` whose camera-facing samples are centred on

@@ -31,6 +31,7 @@ pub mod error;
 pub mod hypotheses;
 pub mod icp;
 pub mod plane;
+pub mod resting;
 pub mod service;
 pub mod sim;
 pub mod symmetry;
