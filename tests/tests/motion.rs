@@ -27,15 +27,15 @@ use tsukami_body::model::LinkId;
 use tsukami_bus::client::{BusClient, RequestError};
 use tsukami_controller::joints::JointTable;
 use tsukami_controller::trajectory::Plan;
-use tsukami_e2e::{models_dir, plugin_entry, planner_entry, test_config, TestBus};
+use tsukami_e2e::{models_dir, planner_entry, plugin_entry, test_config, TestBus};
 use tsukami_msgs::common::Pose;
 use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER, ROLE_TRAJECTORY_PLANNER};
 use tsukami_msgs::motion::{JointTrajectory, MotionPlanReply};
 use tsukami_msgs::planner::{Obstacle, ObstacleShape, PlanReply, SetEnv};
 use tsukami_msgs::ErrorCode;
+use tsukami_scenes::paper_scene;
 use tsukami_scenes::requests::scene_requests;
 use tsukami_scenes::world::World;
-use tsukami_scenes::paper_scene;
 
 const TIMEOUT: Duration = Duration::from_secs(120);
 /// Largest joint change between two re-checks (rad or m).
@@ -46,7 +46,10 @@ const TOUCH: f64 = 1e-3;
 fn motion_entry() -> tsukami::config::PluginEntryConfig {
     let mut entry = plugin_entry(ROLE_TRAJECTORY_PLANNER, "tsukami_trajectory_planner");
     let mut table = toml::Table::new();
-    table.insert("models_dir".into(), models_dir().display().to_string().into());
+    table.insert(
+        "models_dir".into(),
+        models_dir().display().to_string().into(),
+    );
     entry.config = Some(table);
     entry
 }
@@ -55,7 +58,10 @@ fn bus() -> TestBus {
     TestBus::start(test_config(vec![planner_entry(), motion_entry()]))
 }
 
-fn motion(client: &BusClient, request: &serde_json::Value) -> Result<MotionPlanReply, RequestError> {
+fn motion(
+    client: &BusClient,
+    request: &serde_json::Value,
+) -> Result<MotionPlanReply, RequestError> {
     let payload = serde_json::to_vec(request).unwrap();
     client
         .command(ROLE_TRAJECTORY_PLANNER, "plan", &payload, TIMEOUT)
@@ -77,7 +83,11 @@ fn grasp_of(bus: &TestBus, name: &str) -> (PlanReply, World) {
 /// The trajectory's joints as full configurations of the model (rest elsewhere).
 fn full_configs(world: &World, t: &JointTrajectory) -> Vec<Vec<f64>> {
     let model = &world.robot.model;
-    let ids: Vec<usize> = t.joint_names.iter().map(|n| model.joint_id(n).unwrap()).collect();
+    let ids: Vec<usize> = t
+        .joint_names
+        .iter()
+        .map(|n| model.joint_id(n).unwrap())
+        .collect();
     t.points
         .iter()
         .map(|p| {
@@ -94,7 +104,8 @@ fn full_configs(world: &World, t: &JointTrajectory) -> Vec<Vec<f64>> {
 fn check_timing_and_limits(world: &World, t: &JointTrajectory) {
     let model = &world.robot.model;
     let table = JointTable::from_model(model);
-    Plan::check(t, &table, &table.rest_positions(), 1e-9).expect("the controller accepts it from rest");
+    Plan::check(t, &table, &table.rest_positions(), 1e-9)
+        .expect("the controller accepts it from rest");
     assert_eq!(t.points[0].time, 0.0);
     for (k, w) in t.points.windows(2).enumerate() {
         let dt = w[1].time - w[0].time;
@@ -102,15 +113,31 @@ fn check_timing_and_limits(world: &World, t: &JointTrajectory) {
         for (i, name) in t.joint_names.iter().enumerate() {
             let joint = &model.joints[model.joint_id(name).unwrap()];
             let (lim, q) = (joint.limits, w[1].positions[i]);
-            assert!(q >= lim.lower - 1e-9 && q <= lim.upper + 1e-9, "point {}: {name} = {q}", k + 1);
+            assert!(
+                q >= lim.lower - 1e-9 && q <= lim.upper + 1e-9,
+                "point {}: {name} = {q}",
+                k + 1
+            );
             let mean = (w[1].positions[i] - w[0].positions[i]).abs() / dt;
-            assert!(mean <= lim.velocity + 1e-9, "points {k}-{}: {name} at {mean} > {}", k + 1, lim.velocity);
-            assert!(w[1].velocities[i].abs() <= lim.velocity + 1e-9, "point {}: {name} velocity", k + 1);
+            assert!(
+                mean <= lim.velocity + 1e-9,
+                "points {k}-{}: {name} at {mean} > {}",
+                k + 1,
+                lim.velocity
+            );
+            assert!(
+                w[1].velocities[i].abs() <= lim.velocity + 1e-9,
+                "point {}: {name} velocity",
+                k + 1
+            );
         }
     }
     let rest = model.rest_positions();
     for (name, q) in t.joint_names.iter().zip(&t.points[0].positions) {
-        assert!((q - rest[model.joint_id(name).unwrap()]).abs() < 1e-9, "starts at rest: {name}");
+        assert!(
+            (q - rest[model.joint_id(name).unwrap()]).abs() < 1e-9,
+            "starts at rest: {name}"
+        );
     }
 }
 
@@ -148,20 +175,41 @@ impl<'w> Fine<'w> {
                 }
             }
         }
-        let links = (0..n).filter(|&l| !collision.link_parts(l).is_empty()).collect();
-        Fine { world, collision, links, fk: FkState::new(model), checks: 0 }
+        let links = (0..n)
+            .filter(|&l| !collision.link_parts(l).is_empty())
+            .collect();
+        Fine {
+            world,
+            collision,
+            links,
+            fk: FkState::new(model),
+            checks: 0,
+        }
     }
 
     /// Problems of configuration `q` in `phase` (empty when clear).
-    fn problem(&mut self, q: &[f64], phase: &str, carried: Option<(&Isometry3<f64>, &[usize])>) -> Option<String> {
+    fn problem(
+        &mut self,
+        q: &[f64],
+        phase: &str,
+        carried: Option<(&Isometry3<f64>, &[usize])>,
+    ) -> Option<String> {
         self.checks += 1;
         let w = self.world;
         let model = &w.robot.model;
         model.forward_kinematics(q, &mut self.fk);
         let name = |l: LinkId| model.links[l].name.clone();
         let obstacles: Vec<&CollisionObject> = w.obstacles.iter().collect();
-        if let Some(p) = self.collision.first_penetration(&self.fk, &self.links, &obstacles, 0.0) {
-            return Some(format!("{} {:.2} mm inside {}", name(p.link), p.depth * 1e3, obstacles[p.object].name));
+        if let Some(p) = self
+            .collision
+            .first_penetration(&self.fk, &self.links, &obstacles, 0.0)
+        {
+            return Some(format!(
+                "{} {:.2} mm inside {}",
+                name(p.link),
+                p.depth * 1e3,
+                obstacles[p.object].name
+            ));
         }
         if let Some((a, b)) = self.collision.first_self_collision(&self.fk, 0.0) {
             return Some(format!("{} hits {}", name(a), name(b)));
@@ -169,10 +217,16 @@ impl<'w> Fine<'w> {
         let hand = &w.robot.hand_links;
         for &l in &self.links {
             let touch = phase != "reach" && carried.is_none() && hand.contains(&l);
-            let depth = self.collision.link_penetration(&self.fk, l, &w.object.collision);
+            let depth = self
+                .collision
+                .link_penetration(&self.fk, l, &w.object.collision);
             let allowed = if touch { TOUCH } else { 0.0 };
             if carried.is_none() && depth > allowed {
-                return Some(format!("{} {:.2} mm inside the object ({phase})", name(l), depth * 1e3));
+                return Some(format!(
+                    "{} {:.2} mm inside the object ({phase})",
+                    name(l),
+                    depth * 1e3
+                ));
             }
         }
         let (relative, supports) = carried?;
@@ -182,10 +236,19 @@ impl<'w> Fine<'w> {
         let risen = pose.translation.vector.z - w.object.pose.translation.vector.z;
         for (i, o) in w.obstacles.iter().enumerate() {
             if (risen >= 1e-3 || !supports.contains(&i)) && body.intersects(o, 0.0) {
-                return Some(format!("the carried object hits {} (risen {:.1} mm)", o.name, risen * 1e3));
+                return Some(format!(
+                    "the carried object hits {} (risen {:.1} mm)",
+                    o.name,
+                    risen * 1e3
+                ));
             }
         }
-        let others: Vec<LinkId> = self.links.iter().copied().filter(|l| !hand.contains(l)).collect();
+        let others: Vec<LinkId> = self
+            .links
+            .iter()
+            .copied()
+            .filter(|l| !hand.contains(l))
+            .collect();
         self.collision
             .first_collision(&self.fk, &others, &[&body], 0.0)
             .map(|h| format!("{} hits the carried object", name(h.link)))
@@ -197,9 +260,16 @@ fn check_collisions(world: &World, t: &JointTrajectory) -> usize {
     let configs = full_configs(world, t);
     let mut fine = Fine::new(world);
     let palm = world.robot.palm;
-    let lift_from = t.points.iter().position(|p| p.phase == "lift").expect("a lift");
+    let lift_from = t
+        .points
+        .iter()
+        .position(|p| p.phase == "lift")
+        .expect("a lift");
     let mut fk = FkState::new(&world.robot.model);
-    world.robot.model.forward_kinematics(&configs[lift_from - 1], &mut fk);
+    world
+        .robot
+        .model
+        .forward_kinematics(&configs[lift_from - 1], &mut fk);
     let relative = fk.pose(palm).inverse() * world.object.pose;
     let supports: Vec<usize> = (0..world.obstacles.len())
         .filter(|&i| world.object.collision.intersects(&world.obstacles[i], 1e-3))
@@ -208,7 +278,11 @@ fn check_collisions(world: &World, t: &JointTrajectory) -> usize {
         let (a, b) = (&configs[k - 1], &configs[k]);
         let phase = t.points[k].phase.as_str();
         let carried = (phase == "lift").then_some((&relative, supports.as_slice()));
-        let span = a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        let span = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
         let n = (span / FINE).ceil().max(1.0) as usize;
         for i in 0..=n {
             let s = i as f64 / n as f64;
@@ -219,8 +293,12 @@ fn check_collisions(world: &World, t: &JointTrajectory) -> usize {
         }
     }
     // The lift raised the carried object.
-    world.robot.model.forward_kinematics(configs.last().unwrap(), &mut fk);
-    let lifted = (fk.pose(palm) * relative).translation.vector.z - world.object.pose.translation.vector.z;
+    world
+        .robot
+        .model
+        .forward_kinematics(configs.last().unwrap(), &mut fk);
+    let lifted =
+        (fk.pose(palm) * relative).translation.vector.z - world.object.pose.translation.vector.z;
     assert!(lifted > 0.04, "the object rose {lifted} m");
     fine.checks
 }
@@ -232,14 +310,18 @@ fn ends_at_the_grasp(world: &World, t: &JointTrajectory, grasp: &PlanReply) {
     let model = &world.robot.model;
     for (name, g) in &grasp.joint_positions {
         let v = q[model.joint_id(name).unwrap()];
-        assert!((v - g).abs() < 1e-6, "{name}: {v} at the end of close, {g} planned");
+        assert!(
+            (v - g).abs() < 1e-6,
+            "{name}: {v} at the end of close, {g} planned"
+        );
     }
 }
 
 fn plan_and_recheck(name: &str) {
     let bus = bus();
     let (grasp, world) = grasp_of(&bus, name);
-    let reply = motion(&bus.client, &json!({ "grasp": grasp, "seed": 1 })).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let reply = motion(&bus.client, &json!({ "grasp": grasp, "seed": 1 }))
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
     assert_eq!(reply.start_source, "rest", "no controller on this bus");
     let t = &reply.trajectory;
     let phases: Vec<&str> = t.points.iter().map(|p| p.phase.as_str()).collect();
@@ -296,14 +378,25 @@ fn board(name: &str, at: [f64; 3], size: [f64; 3]) -> Obstacle {
     Obstacle {
         name: name.into(),
         shape: ObstacleShape::Box { size },
-        pose: Pose { position: at, quaternion: [0.0, 0.0, 0.0, 1.0] },
+        pose: Pose {
+            position: at,
+            quaternion: [0.0, 0.0, 0.0, 1.0],
+        },
     }
 }
 
 fn set_env(client: &BusClient, obstacles: Vec<Obstacle>) {
-    let env = SetEnv { obstacles, replace: false };
+    let env = SetEnv {
+        obstacles,
+        replace: false,
+    };
     client
-        .command(ROLE_GRASP_PLANNER, planner::SET_ENV, &serde_json::to_vec(&env).unwrap(), TIMEOUT)
+        .command(
+            ROLE_GRASP_PLANNER,
+            planner::SET_ENV,
+            &serde_json::to_vec(&env).unwrap(),
+            TIMEOUT,
+        )
         .expect("set_env");
 }
 
@@ -315,28 +408,54 @@ fn narrow_passage_under_a_shelf_board_is_solved_or_reported() {
     let (_, mut world) = grasp_of(&bus, "can_breast");
     // The can's top is 0.122 m above the counter (1.10 m): the board's underside
     // 8 cm above that, across the whole counter. The grasp is planned with it.
-    let shelf = board("shelf", [0.70, -0.20, 1.10 + 0.122 + 0.08 + 0.005], [0.45, 1.0, 0.01]);
+    let shelf = board(
+        "shelf",
+        [0.70, -0.20, 1.10 + 0.122 + 0.08 + 0.005],
+        [0.45, 1.0, 0.01],
+    );
     set_env(&bus.client, vec![shelf.clone()]);
-    world.obstacles.push(tsukami_scenes::geometry::build_obstacle(&shelf).unwrap());
+    world
+        .obstacles
+        .push(tsukami_scenes::geometry::build_obstacle(&shelf).unwrap());
     let plan = bus
         .client
-        .command(ROLE_GRASP_PLANNER, planner::PLAN, br#"{"seed": 0}"#, TIMEOUT)
+        .command(
+            ROLE_GRASP_PLANNER,
+            planner::PLAN,
+            br#"{"seed": 0}"#,
+            TIMEOUT,
+        )
         .expect("a grasp under the shelf");
     let grasp: PlanReply = serde_json::from_slice(&plan).unwrap();
     let request = json!({ "grasp": grasp, "seed": 3, "max_samples": 3000, "lift_height": 0.05 });
     match motion(&bus.client, &request) {
         Ok(reply) => {
-            eprintln!("narrow passage solved: {} samples, {:.1} ms", reply.samples, reply.planning_ms);
+            eprintln!(
+                "narrow passage solved: {} samples, {:.1} ms",
+                reply.samples, reply.planning_ms
+            );
             check_timing_and_limits(&world, &reply.trajectory);
             ends_at_the_grasp(&world, &reply.trajectory, &grasp);
             check_collisions(&world, &reply.trajectory);
         }
         Err(RequestError::Reply(e)) => {
             assert_eq!(e.error.code, ErrorCode::Infeasible, "{}", e.error.message);
-            let reason = e.error.details.unwrap()["reason"].as_str().unwrap().to_owned();
-            eprintln!("narrow passage reported unsolved: {reason}: {}", e.error.message);
+            let reason = e.error.details.unwrap()["reason"]
+                .as_str()
+                .unwrap()
+                .to_owned();
+            eprintln!(
+                "narrow passage reported unsolved: {reason}: {}",
+                e.error.message
+            );
             assert!(
-                ["no_path", "approach_blocked", "lift_blocked", "pregrasp_unreachable"].contains(&reason.as_str()),
+                [
+                    "no_path",
+                    "approach_blocked",
+                    "lift_blocked",
+                    "pregrasp_unreachable"
+                ]
+                .contains(&reason.as_str()),
                 "{reason}: {}",
                 e.error.message
             );
@@ -360,11 +479,21 @@ fn goal_in_collision_is_infeasible_with_the_reason() {
     model.forward_kinematics(&q, &mut fk);
     let elbow = fk.pose(model.link_id("r_forearm_link").unwrap());
     let at = Translation3::from(elbow.translation.vector).vector;
-    set_env(&bus.client, vec![board("post", [at.x, at.y, at.z], [0.06, 0.06, 0.06])]);
+    set_env(
+        &bus.client,
+        vec![board("post", [at.x, at.y, at.z], [0.06, 0.06, 0.06])],
+    );
     let err = motion(&bus.client, &json!({ "grasp": grasp })).unwrap_err();
-    let RequestError::Reply(e) = err else { panic!("{err}") };
+    let RequestError::Reply(e) = err else {
+        panic!("{err}")
+    };
     assert_eq!(e.error.code, ErrorCode::Infeasible);
-    assert_eq!(e.error.details.as_ref().unwrap()["reason"], "goal_in_collision", "{}", e.error.message);
+    assert_eq!(
+        e.error.details.as_ref().unwrap()["reason"],
+        "goal_in_collision",
+        "{}",
+        e.error.message
+    );
     assert!(e.error.message.contains("`post`"), "{}", e.error.message);
 }
 
@@ -375,24 +504,54 @@ fn bad_grasps_name_the_field_and_the_plugin_keeps_serving() {
     let (grasp, _) = grasp_of(&bus, "can_waist");
     let mut g = serde_json::to_value(&grasp).unwrap();
     let field = |r: Result<MotionPlanReply, RequestError>| match r {
-        Err(RequestError::Reply(e)) => (e.error.code, e.error.details.unwrap()["field"].as_str().unwrap().to_owned()),
+        Err(RequestError::Reply(e)) => (
+            e.error.code,
+            e.error.details.unwrap()["field"]
+                .as_str()
+                .unwrap()
+                .to_owned(),
+        ),
         other => panic!("{other:?}"),
     };
     g["grasp_type"]["name"] = "no_such_type".into();
-    assert_eq!(field(motion(&bus.client, &json!({ "grasp": g }))), (ErrorCode::InvalidValue, "grasp.grasp_type.name".into()));
+    assert_eq!(
+        field(motion(&bus.client, &json!({ "grasp": g }))),
+        (ErrorCode::InvalidValue, "grasp.grasp_type.name".into())
+    );
     let mut g = serde_json::to_value(&grasp).unwrap();
     g["joint_positions"]["no_such_joint"] = 0.1.into();
-    assert_eq!(field(motion(&bus.client, &json!({ "grasp": g }))), (ErrorCode::InvalidValue, "grasp.joint_positions.no_such_joint".into()));
+    assert_eq!(
+        field(motion(&bus.client, &json!({ "grasp": g }))),
+        (
+            ErrorCode::InvalidValue,
+            "grasp.joint_positions.no_such_joint".into()
+        )
+    );
     let mut g = serde_json::to_value(&grasp).unwrap();
     g["palm_pose"]["position"][2] = (grasp.palm_pose.position[2] + 0.2).into();
-    assert_eq!(field(motion(&bus.client, &json!({ "grasp": g }))), (ErrorCode::InvalidValue, "grasp.palm_pose".into()));
+    assert_eq!(
+        field(motion(&bus.client, &json!({ "grasp": g }))),
+        (ErrorCode::InvalidValue, "grasp.palm_pose".into())
+    );
     let mut g = serde_json::to_value(&grasp).unwrap();
     g.as_object_mut().unwrap().remove("joint_positions");
-    assert_eq!(field(motion(&bus.client, &json!({ "grasp": g }))).0, ErrorCode::InvalidRequest);
-    assert_eq!(field(motion(&bus.client, &json!({ "grasp": grasp, "lift_height": -1.0 }))), (ErrorCode::InvalidValue, "lift_height".into()));
+    assert_eq!(
+        field(motion(&bus.client, &json!({ "grasp": g }))).0,
+        ErrorCode::InvalidRequest
+    );
+    assert_eq!(
+        field(motion(
+            &bus.client,
+            &json!({ "grasp": grasp, "lift_height": -1.0 })
+        )),
+        (ErrorCode::InvalidValue, "lift_height".into())
+    );
     // Still serving, same world.
     motion(&bus.client, &json!({ "grasp": grasp })).expect("plans after bad requests");
     // The host lists the role.
     let plugins = bus.client.wait_for_host(TIMEOUT).unwrap();
-    assert!(plugins.plugins.iter().any(|p| p.roles.iter().any(|r| r == ROLE_TRAJECTORY_PLANNER)));
+    assert!(plugins
+        .plugins
+        .iter()
+        .any(|p| p.roles.iter().any(|r| r == ROLE_TRAJECTORY_PLANNER)));
 }

@@ -16,7 +16,13 @@ use tsukami_planner_kit::Session;
 use tsukami_trajectory_planner::motion::{plan_motion, MotionConfig, MotionQuery, Variant};
 use tsukami_trajectory_planner::world::SharedWorld;
 
-const SCENES: [&str; 5] = ["can_breast", "can_waist", "heavy_low", "fridge_pet", "vase_table"];
+const SCENES: [&str; 5] = [
+    "can_breast",
+    "can_waist",
+    "heavy_low",
+    "fridge_pet",
+    "vase_table",
+];
 const SEEDS: u64 = 32;
 
 fn percentile(sorted: &[f64], p: f64) -> f64 {
@@ -24,7 +30,11 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
     sorted[i]
 }
 
-fn times(world: &Session<SharedWorld>, grasp: &MotionGrasp, variant: Variant) -> (Vec<f64>, u32, f64) {
+fn times(
+    world: &Session<SharedWorld>,
+    grasp: &MotionGrasp,
+    variant: Variant,
+) -> (Vec<f64>, u32, f64) {
     let snapshot = world.snapshot();
     let w = snapshot.world().unwrap();
     let cfg = MotionConfig::default();
@@ -41,7 +51,15 @@ fn times(world: &Session<SharedWorld>, grasp: &MotionGrasp, variant: Variant) ->
             acceleration: cfg.acceleration,
         };
         let t = Instant::now();
-        let r = plan_motion(&w, &query, &cfg, &Limits::default(), variant, &|| false, &mut |_, _| {});
+        let r = plan_motion(
+            &w,
+            &query,
+            &cfg,
+            &Limits::default(),
+            variant,
+            &|| false,
+            &mut |_, _| {},
+        );
         out.push(t.elapsed().as_secs_f64() * 1e3);
         if let Ok(m) = r {
             ok += 1;
@@ -68,4 +86,3 @@ fn main() {
         );
     }
 }
-

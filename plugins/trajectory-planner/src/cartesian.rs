@@ -47,7 +47,8 @@ pub fn palm_line(
     from: &[f64],
     line: &Line,
 ) -> Option<Vec<Vec<f64>>> {
-    let (start_pose, direction, length, step) = (&line.start, &line.direction, line.length, line.step);
+    let (start_pose, direction, length, step) =
+        (&line.start, &line.direction, line.length, line.step);
     let selection = JointSelection::new(model, joints).ok()?;
     let options = IkOptions {
         max_attempts: 1,

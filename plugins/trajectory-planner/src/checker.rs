@@ -250,9 +250,9 @@ impl RobotWorld<'_> {
                 with: format!("link `{}`", name(b)),
             });
         }
-        if let Some(hit) = self
-            .collision
-            .first_collision(&self.fk, links, &self.obstacles, self.margin)
+        if let Some(hit) =
+            self.collision
+                .first_collision(&self.fk, links, &self.obstacles, self.margin)
         {
             return Some(Collision {
                 link: name(hit.link),
@@ -265,7 +265,11 @@ impl RobotWorld<'_> {
     fn object_hit(&self) -> Option<Collision> {
         let rule = self.object.as_ref()?;
         let name = |l: LinkId| self.model.links[l].name.clone();
-        let links = if self.checks == 1 { &self.links } else { &self.moving };
+        let links = if self.checks == 1 {
+            &self.links
+        } else {
+            &self.moving
+        };
         let strict: Vec<LinkId> = links
             .iter()
             .copied()
@@ -334,7 +338,10 @@ fn moved_links(model: &RobotModel, joints: &[JointId]) -> Vec<bool> {
         };
         let joint = &model.joints[j];
         let driven = joints.contains(&j)
-            || joint.mimic.as_ref().is_some_and(|m| joints.contains(&m.master));
+            || joint
+                .mimic
+                .as_ref()
+                .is_some_and(|m| joints.contains(&m.master));
         moved[l] = moved[joint.parent] || driven;
     }
     moved

@@ -64,18 +64,27 @@ fn joint_value(
     field: &str,
 ) -> Result<JointId, MotionError> {
     let field = format!("{field}.{name}");
-    let j = model
-        .joint_id(name)
-        .map_err(|_| MotionError::invalid(&field, format!("robot `{}` has no joint `{name}`", model.name)))?;
+    let j = model.joint_id(name).map_err(|_| {
+        MotionError::invalid(
+            &field,
+            format!("robot `{}` has no joint `{name}`", model.name),
+        )
+    })?;
     let joint = &model.joints[j];
     if !joint.is_movable() {
-        return Err(MotionError::invalid(&field, "is a fixed joint and cannot be set"));
+        return Err(MotionError::invalid(
+            &field,
+            "is a fixed joint and cannot be set",
+        ));
     }
     let lim = joint.limits;
     if !value.is_finite() || value < lim.lower - 1e-6 || value > lim.upper + 1e-6 {
         return Err(MotionError::invalid(
             &field,
-            format!("{value} is outside the joint's limits [{}, {}]", lim.lower, lim.upper),
+            format!(
+                "{value} is outside the joint's limits [{}, {}]",
+                lim.lower, lim.upper
+            ),
         ));
     }
     Ok(j)
@@ -101,10 +110,16 @@ fn write_joints(
     }
     model.apply_mimics(q);
     // A mimic joint follows its master; a value given for it must agree.
-    if let Some((name, j, v)) = mimics.into_iter().find(|&(_, j, v)| (q[j] - v).abs() > 1e-6) {
+    if let Some((name, j, v)) = mimics
+        .into_iter()
+        .find(|&(_, j, v)| (q[j] - v).abs() > 1e-6)
+    {
         return Err(MotionError::invalid(
             format!("{field}.{name}"),
-            format!("{v} disagrees with its master joint, which puts this mimic joint at {}", q[j]),
+            format!(
+                "{v} disagrees with its master joint, which puts this mimic joint at {}",
+                q[j]
+            ),
         ));
     }
     Ok(set)
@@ -112,7 +127,11 @@ fn write_joints(
 
 /// The start: `default` (full joint vector) with the request's `start` joints
 /// written over it.
-pub fn start_state(model: &RobotModel, default: &[f64], start: Option<&JointMap>) -> Result<Vec<f64>, MotionError> {
+pub fn start_state(
+    model: &RobotModel,
+    default: &[f64],
+    start: Option<&JointMap>,
+) -> Result<Vec<f64>, MotionError> {
     let mut q = default.to_vec();
     if let Some(start) = start {
         write_joints(model, start, "start", &mut q)?;
@@ -131,7 +150,12 @@ fn reach_joints(
     closed: &[f64],
 ) -> Result<Vec<JointId>, MotionError> {
     let hand = robot.hand();
-    let body: Vec<JointId> = robot.waist.iter().chain(&robot.whole_body).copied().collect();
+    let body: Vec<JointId> = robot
+        .waist
+        .iter()
+        .chain(&robot.whole_body)
+        .copied()
+        .collect();
     let mut used = Vec::new();
     for (i, name) in grasp.joints_used.iter().enumerate() {
         match robot.model.joint_id(name).ok().filter(|j| body.contains(j)) {
@@ -158,12 +182,19 @@ fn reach_joints(
     Ok(reach)
 }
 
-fn approach_direction(robot: &Robot, grasp: &MotionGrasp, palm: &Isometry3<f64>) -> Result<Vector3<f64>, MotionError> {
+fn approach_direction(
+    robot: &Robot,
+    grasp: &MotionGrasp,
+    palm: &Isometry3<f64>,
+) -> Result<Vector3<f64>, MotionError> {
     if let Some(a) = grasp.approach {
         let v = Vector3::from(a);
         let n = v.norm();
         if !n.is_finite() || n < 1e-9 {
-            return Err(MotionError::invalid("grasp.approach", "must be a finite, non-zero vector"));
+            return Err(MotionError::invalid(
+                "grasp.approach",
+                "must be a finite, non-zero vector",
+            ));
         }
         return Ok(v / n);
     }
@@ -171,17 +202,30 @@ fn approach_direction(robot: &Robot, grasp: &MotionGrasp, palm: &Isometry3<f64>)
     let name = &grasp.grasp_type.name;
     let g = types.iter().find(|g| &g.name == name).ok_or_else(|| {
         let known: Vec<&str> = types.iter().map(|g| g.name.as_str()).collect();
-        MotionError::invalid("grasp.grasp_type.name", format!("unknown grasp type `{name}`; the hand has {known:?}"))
+        MotionError::invalid(
+            "grasp.grasp_type.name",
+            format!("unknown grasp type `{name}`; the hand has {known:?}"),
+        )
     })?;
     Ok(palm.rotation * g.approach())
 }
 
 /// Resolves `grasp` from the full `start` configuration.
-pub fn resolve(robot: &Robot, grasp: &MotionGrasp, start: &[f64], limits: &Limits) -> Result<Goal, MotionError> {
+pub fn resolve(
+    robot: &Robot,
+    grasp: &MotionGrasp,
+    start: &[f64],
+    limits: &Limits,
+) -> Result<Goal, MotionError> {
     let model = &robot.model;
     let hand = robot.hand();
     let mut closed = start.to_vec();
-    let set = write_joints(model, &grasp.joint_positions, "grasp.joint_positions", &mut closed)?;
+    let set = write_joints(
+        model,
+        &grasp.joint_positions,
+        "grasp.joint_positions",
+        &mut closed,
+    )?;
     if let Some(&j) = hand.arm.iter().find(|j| !set.contains(j)) {
         return Err(MotionError::invalid(
             "grasp.joint_positions",
@@ -207,7 +251,11 @@ pub fn resolve(robot: &Robot, grasp: &MotionGrasp, start: &[f64], limits: &Limit
         reach,
         hand: hand.joints.clone(),
         open: closed.clone(),
-        flex: hand.fingers.iter().flat_map(|f| f.flex.iter().copied()).collect(),
+        flex: hand
+            .fingers
+            .iter()
+            .flat_map(|f| f.flex.iter().copied())
+            .collect(),
         closed,
         palm,
     };

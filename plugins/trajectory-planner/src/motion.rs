@@ -160,10 +160,22 @@ struct Scene<'a> {
 }
 
 impl<'a> Scene<'a> {
-    fn robot_world(&self, obstacles: Vec<&'a CollisionObject>, joints: Vec<JointId>, base: &[f64]) -> RobotWorld<'a> {
+    fn robot_world(
+        &self,
+        obstacles: Vec<&'a CollisionObject>,
+        joints: Vec<JointId>,
+        base: &[f64],
+    ) -> RobotWorld<'a> {
         let hand = self.world.robot.hand();
-        RobotWorld::new(self.model, &hand.collision, obstacles, joints, base.to_vec(), 0.0)
-            .with_max_travel(self.cfg.max_travel)
+        RobotWorld::new(
+            self.model,
+            &hand.collision,
+            obstacles,
+            joints,
+            base.to_vec(),
+            0.0,
+        )
+        .with_max_travel(self.cfg.max_travel)
     }
 
     /// Every link clear of the obstacles and the object.
@@ -176,11 +188,12 @@ impl<'a> Scene<'a> {
     /// Hand links may touch the object.
     fn touching(&self, base: &[f64]) -> RobotWorld<'a> {
         let hand = self.world.robot.hand();
-        self.robot_world(self.env.clone(), self.joints.clone(), base).with_object(ObjectRule {
-            body: &self.world.object.collision,
-            touching: hand.links.clone(),
-            tolerance: self.cfg.touch_tolerance,
-        })
+        self.robot_world(self.env.clone(), self.joints.clone(), base)
+            .with_object(ObjectRule {
+                body: &self.world.object.collision,
+                touching: hand.links.clone(),
+                tolerance: self.cfg.touch_tolerance,
+            })
     }
 
     /// The object carried by the palm from the grasp on.
@@ -195,7 +208,11 @@ impl<'a> Scene<'a> {
             .map(|v| (relative * v).coords.norm())
             .fold(0.0, f64::max);
         let supports = (0..self.env.len())
-            .filter(|&i| object.collision.intersects(self.env[i], self.cfg.support_clearance))
+            .filter(|&i| {
+                object
+                    .collision
+                    .intersects(self.env[i], self.cfg.support_clearance)
+            })
             .collect();
         let attached = Attached {
             body: object.collision.clone(),
@@ -240,8 +257,21 @@ pub fn plan_motion(
     let model = &world.robot.model;
     let goal = resolve(world.robot, query.grasp, &query.start, limits)?;
     let mut joints = goal.reach.clone();
-    joints.extend(goal.hand.iter().copied().filter(|j| !goal.reach.contains(j)));
-    let mut s = Scene { model, world, goal, joints, env: world.obstacles.clone(), cfg, checks: 0 };
+    joints.extend(
+        goal.hand
+            .iter()
+            .copied()
+            .filter(|j| !goal.reach.contains(j)),
+    );
+    let mut s = Scene {
+        model,
+        world,
+        goal,
+        joints,
+        env: world.obstacles.clone(),
+        cfg,
+        checks: 0,
+    };
     let w = s.free(s.joints.clone(), &query.start);
     s.check(w, &[s.p(&query.start)])
         .map_err(|c| infeasible("start_in_collision", "the start posture collides", &c))?;
@@ -258,10 +288,16 @@ pub fn plan_motion(
     model.apply_mimics(&mut start_open);
     let opening = [s.p(&query.start), s.p(&start_open)];
     let w = s.free(s.joints.clone(), &query.start);
-    s.check(w, &opening)
-        .map_err(|c| infeasible("start_in_collision", "opening the hand at the start collides", &c))?;
+    s.check(w, &opening).map_err(|c| {
+        infeasible(
+            "start_in_collision",
+            "opening the hand at the start collides",
+            &c,
+        )
+    })?;
     progress("reach", 0);
-    let (reach, samples) = reach_path(&mut s, query, &start_open, &approach[0], variant, cancelled)?;
+    let (reach, samples) =
+        reach_path(&mut s, query, &start_open, &approach[0], variant, cancelled)?;
     let mut reach_phase = vec![opening[0].clone()];
     reach_phase.extend(reach.iter().map(|q| s.p(q)));
     progress("close", samples);
@@ -271,9 +307,22 @@ pub fn plan_motion(
     progress("lift", samples);
     let lift = lift_path(&mut s, query.lift_height)?;
     progress("timing", samples);
-    let trajectory = timed(&s, query, [reach_phase, approach.iter().map(|q| s.p(q)).collect(), vec![open, closed], lift]);
+    let trajectory = timed(
+        &s,
+        query,
+        [
+            reach_phase,
+            approach.iter().map(|q| s.p(q)).collect(),
+            vec![open, closed],
+            lift,
+        ],
+    );
     progress("done", samples);
-    Ok(Motion { trajectory, samples, checks: s.checks })
+    Ok(Motion {
+        trajectory,
+        samples,
+        checks: s.checks,
+    })
 }
 
 /// How far the hand opens for the approach, tried in order: as wide as the
@@ -289,7 +338,13 @@ fn open_and_approach(s: &mut Scene<'_>, distance: f64) -> Result<Vec<Vec<f64>>, 
         let w = s.touching(&s.goal.open);
         let tried = s
             .check(w, &[s.p(&s.goal.open)])
-            .map_err(|c| infeasible("goal_in_collision", "the grasp posture with the hand open collides", &c))
+            .map_err(|c| {
+                infeasible(
+                    "goal_in_collision",
+                    "the grasp posture with the hand open collides",
+                    &c,
+                )
+            })
             .and_then(|()| approach_path(s, distance));
         match tried {
             Ok(path) => return Ok(path),
@@ -304,7 +359,12 @@ fn open_and_approach(s: &mut Scene<'_>, distance: f64) -> Result<Vec<Vec<f64>>, 
 /// The approach, pre-grasp first, grasp (hand open) last, as full configurations.
 fn approach_path(s: &mut Scene<'_>, distance: f64) -> Result<Vec<Vec<f64>>, MotionError> {
     let hand = s.world.robot.hand();
-    let line = Line { start: s.goal.palm, direction: -s.goal.approach, length: distance, step: s.cfg.line_step };
+    let line = Line {
+        start: s.goal.palm,
+        direction: -s.goal.approach,
+        length: distance,
+        step: s.cfg.line_step,
+    };
     let mut path = palm_line(s.model, hand.palm, &s.goal.reach, &s.goal.open, &line).ok_or_else(|| {
         MotionError::infeasible(
             "pregrasp_unreachable",
@@ -315,8 +375,13 @@ fn approach_path(s: &mut Scene<'_>, distance: f64) -> Result<Vec<Vec<f64>>, Moti
     path.push(s.goal.open.clone());
     let projected: Vec<Vec<f64>> = path.iter().map(|q| s.p(q)).collect();
     let w = s.touching(&s.goal.open);
-    s.check(w, &projected)
-        .map_err(|c| infeasible("approach_blocked", "the straight approach to the grasp collides", &c))?;
+    s.check(w, &projected).map_err(|c| {
+        infeasible(
+            "approach_blocked",
+            "the straight approach to the grasp collides",
+            &c,
+        )
+    })?;
     Ok(path)
 }
 
@@ -331,9 +396,21 @@ fn reach_path(
 ) -> Result<(Vec<Vec<f64>>, usize), MotionError> {
     let mut w = s.free(s.goal.reach.clone(), start_open);
     let (lower, upper) = w.bounds();
-    let (a, b) = (project(start_open, &s.goal.reach), project(pre, &s.goal.reach));
-    let problem = Problem { lower: &lower, upper: &upper, start: &a, goal: &b };
-    let params = RrtParams { max_samples: query.max_samples, step: s.cfg.rrt_step, seed: query.seed };
+    let (a, b) = (
+        project(start_open, &s.goal.reach),
+        project(pre, &s.goal.reach),
+    );
+    let problem = Problem {
+        lower: &lower,
+        upper: &upper,
+        start: &a,
+        goal: &b,
+    };
+    let params = RrtParams {
+        max_samples: query.max_samples,
+        step: s.cfg.rrt_step,
+        seed: query.seed,
+    };
     let res = w.resolution();
     let planned = plan_counted(&problem, &params, &mut w, &res, cancelled);
     let (path, samples) = match planned {
@@ -352,9 +429,18 @@ fn reach_path(
     Ok((path.iter().map(|q| w.full(q)).collect(), samples))
 }
 
-fn reach_error(e: RrtError, w: &mut RobotWorld<'_>, a: &[f64], b: &[f64], seed: u64) -> MotionError {
+fn reach_error(
+    e: RrtError,
+    w: &mut RobotWorld<'_>,
+    a: &[f64],
+    b: &[f64],
+    seed: u64,
+) -> MotionError {
     let named = |w: &mut RobotWorld<'_>, q: &[f64]| {
-        w.first_hit(q).map_or_else(|| "it is outside the joint limits".to_owned(), |c| c.to_string())
+        w.first_hit(q).map_or_else(
+            || "it is outside the joint limits".to_owned(),
+            |c| c.to_string(),
+        )
     };
     match e {
         RrtError::StartInvalid => MotionError::infeasible("start_in_collision", format!("the start posture (hand open): {}", named(w, a))),
@@ -375,10 +461,21 @@ fn lift_path(s: &mut Scene<'_>, height: f64) -> Result<Vec<Vec<f64>>, MotionErro
         return Ok(path);
     }
     let hand = s.world.robot.hand();
-    let line = Line { start: s.goal.palm, direction: Vector3::z(), length: height, step: s.cfg.line_step };
-    let up = palm_line(s.model, hand.palm, &s.goal.reach, &s.goal.closed, &line).ok_or_else(|| {
-        MotionError::infeasible("lift_unreachable", format!("the palm cannot rise {height} m from the grasp (no IK solution on the line)"))
-    })?;
+    let line = Line {
+        start: s.goal.palm,
+        direction: Vector3::z(),
+        length: height,
+        step: s.cfg.line_step,
+    };
+    let up =
+        palm_line(s.model, hand.palm, &s.goal.reach, &s.goal.closed, &line).ok_or_else(|| {
+            MotionError::infeasible(
+                "lift_unreachable",
+                format!(
+                    "the palm cannot rise {height} m from the grasp (no IK solution on the line)"
+                ),
+            )
+        })?;
     path.extend(up.iter().map(|q| s.p(q)));
     let w = s.carrying();
     s.check(w, &path)
@@ -392,7 +489,11 @@ fn timed(s: &Scene<'_>, query: &MotionQuery<'_>, paths: [Vec<Vec<f64>>; 4]) -> J
         .iter()
         .map(|&j| {
             let v = s.model.joints[j].limits.velocity;
-            if v.is_finite() && v > 0.0 { v } else { s.cfg.default_velocity }
+            if v.is_finite() && v > 0.0 {
+                v
+            } else {
+                s.cfg.default_velocity
+            }
         })
         .collect();
     let limits = timing::Limits {
@@ -400,13 +501,29 @@ fn timed(s: &Scene<'_>, query: &MotionQuery<'_>, paths: [Vec<Vec<f64>>; 4]) -> J
         acceleration: vec![query.acceleration; s.joints.len()],
         sample_dt: s.cfg.sample_dt,
     };
-    let names = s.joints.iter().map(|&j| s.model.joints[j].name.clone()).collect();
+    let names = s
+        .joints
+        .iter()
+        .map(|&j| s.model.joints[j].name.clone())
+        .collect();
     let [reach, approach, close, lift] = paths;
     let phases = [
-        Phase { name: "reach", path: reach },
-        Phase { name: "approach", path: approach },
-        Phase { name: "close", path: close },
-        Phase { name: "lift", path: lift },
+        Phase {
+            name: "reach",
+            path: reach,
+        },
+        Phase {
+            name: "approach",
+            path: approach,
+        },
+        Phase {
+            name: "close",
+            path: close,
+        },
+        Phase {
+            name: "lift",
+            path: lift,
+        },
     ];
     assemble(names, &phases, &limits)
 }

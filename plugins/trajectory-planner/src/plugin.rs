@@ -45,7 +45,12 @@ pub struct TrajectoryPlugin {
     controller_timeout: Duration,
 }
 
-fn number(table: &mut toml::Table, key: &str, default: f64, range: (f64, f64)) -> Result<f64, String> {
+fn number(
+    table: &mut toml::Table,
+    key: &str,
+    default: f64,
+    range: (f64, f64),
+) -> Result<f64, String> {
     let Some(v) = table.remove(key) else {
         return Ok(default);
     };
@@ -54,7 +59,10 @@ fn number(table: &mut toml::Table, key: &str, default: f64, range: (f64, f64)) -
         .or_else(|| v.as_integer().map(|i| i as f64))
         .ok_or_else(|| format!("plugin config: `{key}` must be a number"))?;
     if !(range.0..=range.1).contains(&x) {
-        return Err(format!("plugin config: `{key}` = {x} is outside [{}, {}]", range.0, range.1));
+        return Err(format!(
+            "plugin config: `{key}` = {x} is outside [{}, {}]",
+            range.0, range.1
+        ));
     }
     Ok(x)
 }
@@ -69,7 +77,12 @@ pub fn motion_config(table: &toml::Table) -> Result<(MotionConfig, Duration), St
         sample_dt: number(&mut t, "sample_dt", d.sample_dt, (1e-3, 1.0))?,
         max_travel: number(&mut t, "max_travel", d.max_travel, (1e-4, 0.005))?,
         touch_tolerance: number(&mut t, "touch_tolerance", d.touch_tolerance, (0.0, 0.005))?,
-        shortcut_attempts: number(&mut t, "shortcut_attempts", d.shortcut_attempts as f64, (0.0, 1e5))? as usize,
+        shortcut_attempts: number(
+            &mut t,
+            "shortcut_attempts",
+            d.shortcut_attempts as f64,
+            (0.0, 1e5),
+        )? as usize,
         ..d
     };
     let timeout = number(&mut t, "controller_timeout_ms", 200.0, (0.0, 1e4))?;
@@ -81,12 +94,19 @@ pub fn motion_config(table: &toml::Table) -> Result<(MotionConfig, Duration), St
 
 impl TrajectoryPlugin {
     /// The default start and where it came from: the controller's state, else rest.
-    fn default_start(&self, model: &tsukami_body::model::RobotModel, ask: bool) -> (Vec<f64>, &'static str) {
+    fn default_start(
+        &self,
+        model: &tsukami_body::model::RobotModel,
+        ask: bool,
+    ) -> (Vec<f64>, &'static str) {
         let mut q = model.rest_positions();
         if !ask || self.controller_timeout.is_zero() {
             return (q, "rest");
         }
-        let Ok(bytes) = self.host.request("controller/state", b"{}", self.controller_timeout) else {
+        let Ok(bytes) = self
+            .host
+            .request("controller/state", b"{}", self.controller_timeout)
+        else {
             return (q, "rest");
         };
         let Ok(state) = serde_json::from_slice::<ControllerState>(&bytes) else {
@@ -110,22 +130,35 @@ impl TrajectoryPlugin {
             return Err(MotionError::invalid("lift_height", "must be 0 to 0.5 m"));
         }
         if !in_range(req.pregrasp_distance, 0.005, 0.3) {
-            return Err(MotionError::invalid("pregrasp_distance", "must be 0.005 to 0.3 m"));
+            return Err(MotionError::invalid(
+                "pregrasp_distance",
+                "must be 0.005 to 0.3 m",
+            ));
         }
         let most = self.config.max_samples;
         if !(1..=most).contains(&req.max_samples) {
-            return Err(MotionError::invalid("max_samples", format!("must be 1 to {most}")));
+            return Err(MotionError::invalid(
+                "max_samples",
+                format!("must be 1 to {most}"),
+            ));
         }
         let a = req.max_acceleration.unwrap_or(self.motion.acceleration);
         if !in_range(a, 1e-3, 1e3) {
-            return Err(MotionError::invalid("max_acceleration", "must be 0.001 to 1000"));
+            return Err(MotionError::invalid(
+                "max_acceleration",
+                "must be 0.001 to 1000",
+            ));
         }
         Ok(a)
     }
 
     fn plan(&self, payload: &[u8], ctx: &CallContext<'_>) -> Result<Vec<u8>, CallError> {
         let t0 = Instant::now();
-        let payload: &[u8] = if payload.iter().all(u8::is_ascii_whitespace) { b"{}" } else { payload };
+        let payload: &[u8] = if payload.iter().all(u8::is_ascii_whitespace) {
+            b"{}"
+        } else {
+            payload
+        };
         let req: MotionPlanRequest = parse_request(payload).map_err(|r| {
             let mut e = CallError::new(r.error.code.as_str(), r.error.message);
             if let Some(d) = r.error.details {
@@ -163,11 +196,23 @@ impl TrajectoryPlugin {
             }
         };
         let cancelled = || cancel.load(Ordering::Relaxed);
-        let motion = plan_motion(&world, &query, &self.motion, &self.config.limits, Variant::default(), &cancelled, &mut progress)
-            .map_err(fail)?;
+        let motion = plan_motion(
+            &world,
+            &query,
+            &self.motion,
+            &self.config.limits,
+            Variant::default(),
+            &cancelled,
+            &mut progress,
+        )
+        .map_err(fail)?;
         let reply = MotionPlanReply {
             trajectory: motion.trajectory,
-            start_source: if req.start.is_some() { "request".into() } else { source.into() },
+            start_source: if req.start.is_some() {
+                "request".into()
+            } else {
+                source.into()
+            },
             samples: motion.samples.min(u32::MAX as usize) as u32,
             checks: motion.checks as u64,
             planning_ms: t0.elapsed().as_secs_f64() * 1e3,
@@ -202,11 +247,18 @@ impl Plugin for TrajectoryPlugin {
         })
     }
 
-    fn call(&self, command: &str, payload: &[u8], ctx: &CallContext<'_>) -> Result<Vec<u8>, CallError> {
+    fn call(
+        &self,
+        command: &str,
+        payload: &[u8],
+        ctx: &CallContext<'_>,
+    ) -> Result<Vec<u8>, CallError> {
         match command {
             "plan" => self.plan(payload, ctx),
             // World changes, the host's two-phase world commands and `stop`.
-            _ => self.session.handle(command, payload, ctx.cancel_flag(), &mut |_| {}),
+            _ => self
+                .session
+                .handle(command, payload, ctx.cancel_flag(), &mut |_| {}),
         }
     }
 }

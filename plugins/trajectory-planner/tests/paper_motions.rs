@@ -23,8 +23,16 @@ fn motion(scene: &str, seed: u64) -> (Motion, MotionGrasp) {
         acceleration: 2.0,
     };
     let cfg = MotionConfig::default();
-    let m = plan_motion(&w, &query, &cfg, &Limits::default(), Variant::default(), &|| false, &mut |_, _| {})
-        .unwrap_or_else(|e| panic!("{scene}: {e}"));
+    let m = plan_motion(
+        &w,
+        &query,
+        &cfg,
+        &Limits::default(),
+        Variant::default(),
+        &|| false,
+        &mut |_, _| {},
+    )
+    .unwrap_or_else(|e| panic!("{scene}: {e}"));
     (m, grasp)
 }
 

@@ -43,7 +43,9 @@ pub fn scene(scene: &str, seed: u64) -> (Session<SharedWorld>, MotionGrasp) {
     let library = LoadedLibrary::load(&grasp_planner_file()).expect("the grasp planner loads");
     let host = FfiHost_TO::from_ptr(RArc::new(OfflineHost::new()), TD_Opaque);
     let config = format!("models_dir = {:?}", models().display().to_string());
-    let planner = library.create(host, &config).expect("the grasp planner starts");
+    let planner = library
+        .create(host, &config)
+        .expect("the grasp planner starts");
     let cancel = AtomicBool::new(false);
     let call = |command: &str, payload: Vec<u8>| {
         planner
