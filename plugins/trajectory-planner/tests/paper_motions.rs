@@ -82,3 +82,44 @@ fn fridge_pet() {
 fn vase_table() {
     check("vase_table");
 }
+
+/// Progress names the phases in order; a raised cancel flag stops the reach
+/// planner with `Cancelled` (what the host's `stop` does to a running call).
+#[test]
+fn progress_in_phase_order_and_stop_cancels() {
+    let (world, grasp) = common::grasps::scene("can_breast", 0);
+    let snapshot = world.snapshot();
+    let w = snapshot.world().unwrap();
+    let query = MotionQuery {
+        grasp: &grasp,
+        start: w.robot.model.rest_positions(),
+        lift_height: 0.05,
+        pregrasp_distance: 0.05,
+        seed: 1,
+        max_samples: 5000,
+        acceleration: 2.0,
+    };
+    let cfg = MotionConfig::default();
+    let mut phases = Vec::new();
+    let run = |cancel: bool, phases: &mut Vec<String>| {
+        plan_motion(
+            &w,
+            &query,
+            &cfg,
+            &Limits::default(),
+            Variant::default(),
+            &|| cancel,
+            &mut |p, _| phases.push(p.to_owned()),
+        )
+    };
+    run(false, &mut phases).unwrap();
+    assert_eq!(
+        phases,
+        ["approach", "reach", "close", "lift", "timing", "done"]
+    );
+    let cancelled = run(true, &mut Vec::new());
+    assert_eq!(
+        cancelled,
+        Err(tsukami_trajectory_planner::error::MotionError::Cancelled)
+    );
+}
