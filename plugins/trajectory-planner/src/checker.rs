@@ -23,14 +23,15 @@
 //! [`RobotWorld::first_hit`] names what collides. The first check of a world
 //! covers every link; later ones only the links the planned joints move (the
 //! others keep the pose the first check saw), and only link pairs one of which
-//! moves. Every check is counted.
+//! moves; pairs whose bounding spheres (about the link frames) are apart skip the
+//! exact test. Every check is counted.
 
 use nalgebra::{Isometry3, Vector3};
 use tsukami_body::collision::{CollisionObject, RobotCollision};
 use tsukami_body::kinematics::FkState;
 use tsukami_body::model::{JointId, LinkId, RobotModel};
 
-use crate::resolution::SweepBound;
+use crate::resolution::{link_radius, SweepBound};
 use crate::rrt_connect::{SegmentSteps, Validity};
 
 /// Default largest travel of any link point between two checks of a segment:
@@ -48,6 +49,8 @@ pub struct RobotWorld<'a> {
     links: Vec<LinkId>,
     /// Links with geometry that the planned joints move.
     moving: Vec<LinkId>,
+    /// Per link: radius of a sphere about its frame origin holding its geometry.
+    radius: Vec<f64>,
     joints: Vec<JointId>,
     base: Vec<f64>,
     margin: f64,
@@ -138,6 +141,7 @@ impl<'a> RobotWorld<'a> {
             collision,
             moving_pairs,
             obstacles,
+            radius: (0..model.links.len()).map(|l| link_radius(model, l)).collect(),
             links,
             moving,
             joints,
@@ -242,6 +246,7 @@ impl RobotWorld<'_> {
         let (pairs, links) = if self.checks == 1 {
             (self.collision, &self.links)
         } else {
+            self.prune_pairs();
             (&self.moving_pairs, &self.moving)
         };
         if let Some((a, b)) = pairs.first_self_collision(&self.fk, self.margin) {
@@ -260,6 +265,25 @@ impl RobotWorld<'_> {
             });
         }
         self.object_hit().or_else(|| self.attached_hit())
+    }
+
+    /// Broad phase: of the pairs with a moving link that may not touch, only
+    /// those whose bounding spheres overlap go to the exact test.
+    fn prune_pairs(&mut self) {
+        for &a in &self.moving {
+            let pa = self.fk.pose(a).translation.vector;
+            for &b in &self.links {
+                if self.collision.is_allowed(a, b) {
+                    continue;
+                }
+                let d = (self.fk.pose(b).translation.vector - pa).norm();
+                if d <= self.radius[a] + self.radius[b] + self.margin {
+                    self.moving_pairs.disallow(a, b);
+                } else {
+                    self.moving_pairs.allow(a, b);
+                }
+            }
+        }
     }
 
     fn object_hit(&self) -> Option<Collision> {
