@@ -74,6 +74,8 @@ pub struct DetectParams {
     pub early_accept: f64,
     /// Also start from the model's resting poses on the plane under a segment.
     pub resting_hypotheses: bool,
+    /// ... only for a segment whose best principal-axis coarse score is below this.
+    pub resting_below: f64,
     /// Also try the union of two clusters no larger than the object together.
     pub merge_pairs: bool,
     /// Report only poses resting on a found plane (within the two limits below).
@@ -117,6 +119,7 @@ impl Default for DetectParams {
             max_fine: 4,
             early_accept: 0.9,
             resting_hypotheses: true,
+            resting_below: 0.96,
             merge_pairs: true,
             require_support: true,
             max_penetration: 0.01,
@@ -322,19 +325,24 @@ fn coarse_fits(
             continue;
         };
         let pts = thin(&seg.points, params.coarse_points);
-        let mut starts = from_principal_axes(template, &m, cam);
-        if params.resting_hypotheses {
+        let fit = |h: Isometry3<f64>| {
+            let f = refine(template, &pts, Some(*cam), h, &params.coarse);
+            (score(&f), si, f)
+        };
+        let mut fits: Vec<(f64, usize, IcpFit)> = from_principal_axes(template, &m, cam)
+            .into_iter()
+            .map(fit)
+            .collect();
+        let best = fits.iter().map(|f| f.0).fold(f64::NEG_INFINITY, f64::max);
+        if params.resting_hypotheses && best < params.resting_below {
             if let Some(plane) = plane_below(planes, &m.centroid) {
-                starts.extend(on_plane(template, &seg.points, &plane.plane, cam));
+                fits.extend(
+                    on_plane(template, &seg.points, &plane.plane, cam)
+                        .into_iter()
+                        .map(fit),
+                );
             }
         }
-        let mut fits: Vec<(f64, usize, IcpFit)> = starts
-            .into_iter()
-            .map(|h| {
-                let f = refine(template, &pts, Some(*cam), h, &params.coarse);
-                (score(&f), si, f)
-            })
-            .collect();
         fits.sort_by(|a, b| b.0.total_cmp(&a.0));
         coarse.extend(fits.into_iter().take(params.refine_top));
     }
