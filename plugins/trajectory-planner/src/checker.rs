@@ -51,6 +51,8 @@ pub struct RobotWorld<'a> {
     moving: Vec<LinkId>,
     /// Per link: radius of a sphere about its frame origin holding its geometry.
     radius: Vec<f64>,
+    /// Per obstacle: a bounding sphere (centre, radius).
+    spheres: Vec<(Vector3<f64>, f64)>,
     joints: Vec<JointId>,
     base: Vec<f64>,
     margin: f64,
@@ -140,8 +142,9 @@ impl<'a> RobotWorld<'a> {
             model,
             collision,
             moving_pairs,
-            obstacles,
             radius: (0..model.links.len()).map(|l| link_radius(model, l)).collect(),
+            spheres: obstacles.iter().map(|o| bounding_sphere(o)).collect(),
+            obstacles,
             links,
             moving,
             joints,
@@ -255,14 +258,26 @@ impl RobotWorld<'_> {
                 with: format!("link `{}`", name(b)),
             });
         }
-        if let Some(hit) =
-            self.collision
-                .first_collision(&self.fk, links, &self.obstacles, self.margin)
-        {
-            return Some(Collision {
-                link: name(hit.link),
-                with: format!("obstacle `{}`", self.obstacles[hit.object].name),
-            });
+        for (o, &(centre, r)) in self.spheres.iter().enumerate() {
+            // Broad phase: only links whose bounding sphere reaches the obstacle's.
+            let near: Vec<LinkId> = links
+                .iter()
+                .copied()
+                .filter(|&l| {
+                    (self.fk.pose(l).translation.vector - centre).norm()
+                        <= r + self.radius[l] + self.margin
+                })
+                .collect();
+            let body = [self.obstacles[o]];
+            if let Some(hit) = self
+                .collision
+                .first_collision(&self.fk, &near, &body, self.margin)
+            {
+                return Some(Collision {
+                    link: name(hit.link),
+                    with: format!("obstacle `{}`", body[0].name),
+                });
+            }
         }
         self.object_hit().or_else(|| self.attached_hit())
     }
@@ -349,6 +364,23 @@ impl Validity for RobotWorld<'_> {
     fn is_valid(&mut self, q: &[f64]) -> bool {
         self.first_hit(q).is_none()
     }
+}
+
+/// A sphere holding every part of `object` (from the parts' world AABBs).
+fn bounding_sphere(object: &CollisionObject) -> (Vector3<f64>, f64) {
+    let pose = tsukami_body::convert::to_pose(object.pose());
+    let mut lo = Vector3::repeat(f64::INFINITY);
+    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
+    for part in object.parts() {
+        let aabb = part.shape.compute_aabb(&(pose * part.origin));
+        lo = lo.inf(&tsukami_body::convert::to_vector(aabb.mins));
+        hi = hi.sup(&tsukami_body::convert::to_vector(aabb.maxs));
+    }
+    if !lo.iter().chain(hi.iter()).all(|v| v.is_finite()) {
+        // No finite box (or no part): every link counts as near it.
+        return (Vector3::zeros(), f64::INFINITY);
+    }
+    ((lo + hi) / 2.0, (hi - lo).norm() / 2.0)
 }
 
 /// Per link: does a planned joint (or a mimic joint following one) move it?
