@@ -73,7 +73,11 @@ fn view_draws_a_scene_headless_and_names_bad_arguments() {
         "--size",
         "320x240",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let picture = std::fs::read(&png).unwrap();
     assert_eq!(&picture[..8], b"\x89PNG\r\n\x1a\n");
     // IHDR: width and height, big-endian, right after the chunk's length and type.
@@ -82,11 +86,17 @@ fn view_draws_a_scene_headless_and_names_bad_arguments() {
     for (extra, named) in [
         (&["--out", "x.png", "--size", "0x5"][..], "--size"),
         (&["--out", "x.png", "--eye", "1,2"][..], "--eye"),
-        (&["--out", "x.png", "--result", "/nonexistent/reply.json"][..], "result"),
+        (
+            &["--out", "x.png", "--result", "/nonexistent/reply.json"][..],
+            "result",
+        ),
     ] {
         let out = view(extra);
         let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success() && stderr.contains(named), "{extra:?}: {stderr}");
+        assert!(
+            !out.status.success() && stderr.contains(named),
+            "{extra:?}: {stderr}"
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -99,20 +109,45 @@ fn demo_matches_the_paper_and_writes_its_report() {
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let scenes: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     let scenes = scenes.as_array().unwrap();
-    let names: Vec<&str> = scenes.iter().map(|s| s["scene"].as_str().unwrap()).collect();
-    assert_eq!(names, ["can_breast", "can_waist", "heavy_low", "fridge_pet", "vase_table"]);
+    let names: Vec<&str> = scenes
+        .iter()
+        .map(|s| s["scene"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "can_breast",
+            "can_waist",
+            "heavy_low",
+            "fridge_pet",
+            "vase_table"
+        ]
+    );
     let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
     for s in scenes {
         let name = s["scene"].as_str().unwrap();
         // `ok` is the paper check's verdict, recomputed from the reply's contacts.
         assert_eq!(s["ok"], true, "{name}: {}", s["problem"]);
         assert!(s["weight_scale"].as_f64().unwrap() >= 1.0, "{name}");
-        assert!(report.contains(&format!("| {name} | {} |", s["result"]["grasp_type"]["name"].as_str().unwrap())));
-        assert_eq!(&std::fs::read(dir.join(format!("{name}.png"))).unwrap()[..4], b"\x89PNG");
-        assert_eq!(&std::fs::read(dir.join(format!("{name}.glb"))).unwrap()[..4], b"glTF");
+        assert!(report.contains(&format!(
+            "| {name} | {} |",
+            s["result"]["grasp_type"]["name"].as_str().unwrap()
+        )));
+        assert_eq!(
+            &std::fs::read(dir.join(format!("{name}.png"))).unwrap()[..4],
+            b"\x89PNG"
+        );
+        assert_eq!(
+            &std::fs::read(dir.join(format!("{name}.glb"))).unwrap()[..4],
+            b"glTF"
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

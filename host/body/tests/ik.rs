@@ -24,7 +24,9 @@ fn arm_reaches_random_reachable_targets() {
     let rest = m.rest_positions();
     let arm: Vec<usize> = common::humanoid_groups()
         .arm
-        .iter().map(|n| m.joint_id(n).unwrap()).collect();
+        .iter()
+        .map(|n| m.joint_id(n).unwrap())
+        .collect();
     let (mut ok, n) = (0, 1000);
     let mut iterations = 0;
     for _ in 0..n {

@@ -364,7 +364,6 @@ grc_des = { position = [0.05, 0, 0.06], size = [0.06, 0.06, 0.10] }
 mod tests {
     use super::*;
 
-
     #[test]
     fn parses_minimal_file() {
         let cfg = GraspTypeConfig::from_toml_str(ONE_TYPE_EXAMPLE).unwrap();

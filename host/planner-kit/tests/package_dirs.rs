@@ -19,7 +19,10 @@ fn root_with_packaged_arm(tag: &str) -> PathBuf {
     let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/robots");
     for (robot, files) in [
         ("tsukami_humanoid", &["grasp_types.toml"][..]),
-        ("tsukami_arm7", &["description.toml", "tsukami_arm7.urdf"][..]),
+        (
+            "tsukami_arm7",
+            &["description.toml", "tsukami_arm7.urdf"][..],
+        ),
     ] {
         let dir = root.join("robots").join(robot);
         fs::create_dir_all(&dir).unwrap();
@@ -50,8 +53,18 @@ fn cube_stl(h: f64) -> String {
     };
     // Outward-wound faces of the cube as vertex-index triangles.
     let faces = [
-        [0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
-        [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5],
+        [0, 2, 1],
+        [1, 2, 3],
+        [4, 5, 6],
+        [5, 7, 6],
+        [0, 1, 4],
+        [1, 5, 4],
+        [2, 6, 3],
+        [3, 6, 7],
+        [0, 4, 2],
+        [2, 4, 6],
+        [1, 3, 5],
+        [3, 7, 5],
     ];
     let mut s = String::from("solid cube\n");
     for f in faces {
@@ -93,7 +106,12 @@ fn package_dirs_find_a_mesh_package_inside_the_roots() {
 fn package_dirs_outside_the_roots_or_too_many_are_refused() {
     let root = root_with_packaged_arm("bad");
     let models = Models::new([root.clone()]);
-    for dir in ["/etc", "../..", "pkgs/vendor/arm7_meshes/bracket.stl", "nope"] {
+    for dir in [
+        "/etc",
+        "../..",
+        "pkgs/vendor/arm7_meshes/bracket.stl",
+        "nope",
+    ] {
         let e = Robot::load(&models, &request(&["pkgs", dir]))
             .map(|_| ())
             .unwrap_err();
@@ -103,7 +121,9 @@ fn package_dirs_outside_the_roots_or_too_many_are_refused() {
         assert!(!text.contains(&root.display().to_string()), "{text}");
     }
     let many = vec!["pkgs"; SetRobot::MAX_PACKAGE_DIRS + 1];
-    let e = Robot::load(&models, &request(&many)).map(|_| ()).unwrap_err();
+    let e = Robot::load(&models, &request(&many))
+        .map(|_| ())
+        .unwrap_err();
     assert_eq!(e.code(), ErrorCode::InvalidValue, "{e}");
     assert!(e.to_string().contains("package_dirs"), "{e}");
     fs::remove_dir_all(&root).unwrap();

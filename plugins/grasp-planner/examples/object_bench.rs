@@ -193,10 +193,7 @@ fn size_figures(planner: &Planner, path: &str, reps: usize, seeds: u64) -> (f64,
     let mut triangles = 0;
     for _ in 0..reps {
         let t = Instant::now();
-        triangles = planner
-            .set_object(&req)
-            .expect("the can loads")
-            .triangles;
+        triangles = planner.set_object(&req).expect("the can loads").triangles;
         set.push(t.elapsed().as_secs_f64() * 1e3);
     }
     set.sort_by(f64::total_cmp);

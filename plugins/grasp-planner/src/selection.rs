@@ -233,9 +233,27 @@ mod tests {
     /// The test hand's three mid-size types.
     fn types() -> GraspTypeConfig {
         let text = [
-            grasp_type("fingertip4_mid", [0.0, 0.3], [0.03, 0.085, 0.02], [0.065, 0.12, 0.065], 0.09),
-            grasp_type("fingertip3_mid", [0.0, 0.3], [0.02, 0.04, 0.01], [0.06, 0.06, 0.06], 0.09),
-            grasp_type("envelope4_mid", [0.25, 1.5], [0.04, 0.085, 0.04], [0.07, 0.15, 0.07], 0.10),
+            grasp_type(
+                "fingertip4_mid",
+                [0.0, 0.3],
+                [0.03, 0.085, 0.02],
+                [0.065, 0.12, 0.065],
+                0.09,
+            ),
+            grasp_type(
+                "fingertip3_mid",
+                [0.0, 0.3],
+                [0.02, 0.04, 0.01],
+                [0.06, 0.06, 0.06],
+                0.09,
+            ),
+            grasp_type(
+                "envelope4_mid",
+                [0.25, 1.5],
+                [0.04, 0.085, 0.04],
+                [0.07, 0.15, 0.07],
+                0.10,
+            ),
         ]
         .concat();
         GraspTypeConfig::from_toml_str(&text).unwrap()

@@ -142,7 +142,9 @@ impl<'a> RobotWorld<'a> {
             model,
             collision,
             moving_pairs,
-            radius: (0..model.links.len()).map(|l| link_radius(model, l)).collect(),
+            radius: (0..model.links.len())
+                .map(|l| link_radius(model, l))
+                .collect(),
             spheres: obstacles.iter().map(|o| bounding_sphere(o)).collect(),
             obstacles,
             links,
