@@ -33,7 +33,7 @@ fn planner() -> Planner {
 
 fn ready() -> Planner {
     let req = scene_requests(&models().join("scenes/can_breast.toml")).unwrap();
-    let mut p = planner();
+    let p = planner();
     p.set_robot(&req.robot).unwrap();
     p.set_object(&req.object).unwrap();
     p.set_env(&req.env).unwrap();
@@ -187,7 +187,7 @@ fn unseen_mesh_is_planned() {
 
 #[test]
 fn bad_env_and_options_are_refused() {
-    let mut p = ready();
+    let p = ready();
     let n = p
         .remove_env(&RemoveEnv {
             names: vec![],

@@ -18,7 +18,7 @@ fn models() -> PathBuf {
 /// A real reply for `scene` (seed 0), the checker's world and the region count.
 fn planned(scene: &str) -> (PlanReply, World, usize) {
     let req = scene_requests(&models().join("scenes").join(format!("{scene}.toml"))).unwrap();
-    let mut p = Planner::new(models());
+    let p = Planner::new(models());
     p.set_robot(&req.robot).unwrap();
     let regions = p.set_object(&req.object).unwrap().regions.len();
     p.set_env(&req.env).unwrap();

@@ -28,7 +28,7 @@ fn scene_path(name: &str) -> PathBuf {
 /// A planner set up for `scene`, and the number of OCP regions of its object.
 fn setup(scene: &str) -> (Planner, usize) {
     let req = scene_requests(&scene_path(scene)).unwrap();
-    let mut p = Planner::new(models());
+    let p = Planner::new(models());
     p.set_robot(&req.robot).unwrap();
     let obj = p.set_object(&req.object).unwrap();
     p.set_env(&req.env).unwrap();

@@ -16,10 +16,10 @@ fn plans_the_can_through_the_plugin_interface() {
     let host = offline.host();
     let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
     let config = format!("models_dir = {:?}", models.display().to_string());
-    let mut plugin = GraspPlannerPlugin::new(host.clone(), &config).unwrap();
+    let plugin = GraspPlannerPlugin::new(host.clone(), &config).unwrap();
     let cancel = AtomicBool::new(false);
     let ctx = CallContext::new(&cancel, &host);
-    let mut call = |c: &str, body: &str| plugin.call(c, body.as_bytes(), &ctx);
+    let call = |c: &str, body: &str| plugin.call(c, body.as_bytes(), &ctx);
 
     // Plan before anything is set: not_ready, with the planner's reason.
     let e = call("plan", "{}").unwrap_err();

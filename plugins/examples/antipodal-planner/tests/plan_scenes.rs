@@ -17,7 +17,7 @@ fn models() -> PathBuf {
 
 fn planner_for(scene: &str) -> AntipodalPlanner {
     let req = tsukami_scenes::scene_requests(&models().join("scenes").join(scene)).unwrap();
-    let mut p = AntipodalPlanner::new(models());
+    let p = AntipodalPlanner::new(models());
     p.set_robot(&req.robot).unwrap();
     p.set_object(&req.object).unwrap();
     p.set_env(&req.env).unwrap();

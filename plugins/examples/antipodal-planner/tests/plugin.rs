@@ -41,7 +41,7 @@ fn assert_holds(req: &SceneRequests, reply: &PlanReply) {
 
 #[test]
 fn plans_can_breast_through_the_plugin_interface() {
-    let (rec, host, mut plugin) = setup();
+    let (rec, host, plugin) = setup();
     let cancel = AtomicBool::new(false);
     let ctx = CallContext::new(&cancel, &host);
     let e = plugin.call("plan", b"{}", &ctx).unwrap_err();
@@ -74,7 +74,7 @@ fn plans_can_breast_through_the_plugin_interface() {
 
 #[test]
 fn bad_input_names_the_field_and_keeps_state() {
-    let (_rec, host, mut plugin) = setup();
+    let (_rec, host, plugin) = setup();
     let cancel = AtomicBool::new(false);
     let ctx = CallContext::new(&cancel, &host);
     let req = scene_requests(&models().join("scenes/can_waist.toml")).unwrap();
@@ -149,7 +149,7 @@ fn bad_input_names_the_field_and_keeps_state() {
 
 #[test]
 fn a_cancel_raised_mid_plan_stops_it() {
-    let (rec, host, mut plugin) = setup();
+    let (rec, host, plugin) = setup();
     let cancel = AtomicBool::new(false);
     let ctx = CallContext::new(&cancel, &host);
     let req = scene_requests(&models().join("scenes/can_breast.toml")).unwrap();
@@ -184,7 +184,7 @@ fn a_cancel_raised_mid_plan_stops_it() {
 
 #[test]
 fn an_unreachable_object_is_infeasible() {
-    let (_rec, host, mut plugin) = setup();
+    let (_rec, host, plugin) = setup();
     let cancel = AtomicBool::new(false);
     let ctx = CallContext::new(&cancel, &host);
     let req = scene_requests(&models().join("scenes/can_breast.toml")).unwrap();
