@@ -43,7 +43,7 @@
 //! use tsukami_scenes::verify::{verify, Tolerances};
 //! use tsukami_scenes::world::World;
 //! use tsukami_scenes::scene_requests;
-//! # fn reply() -> tsukami_msgs::planner::PlanReply { unimplemented!() }
+//! # fn reply() -> tsukami_msgs::planner::PlanReply { panic!("a Plan reply, e.g. from `tsukami plan`") }
 //! let models = Path::new("models");
 //! let req = scene_requests(&models.join("scenes/can_breast.toml")).unwrap();
 //! let world = World::from_requests(models, &req.robot, &req.object, &req.env).unwrap();
