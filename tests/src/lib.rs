@@ -173,6 +173,29 @@ pub fn tsukami_exe() -> PathBuf {
         .expect("tsukami binary after build")
 }
 
+/// The binary `name` of package `package` (a component: `tsukami-vision`,
+/// `tsukami-controller`), beside [`tsukami_exe`], brought up to date by
+/// `cargo build` once per test process: `cargo test -p tsukami-e2e` builds this
+/// package's binaries only (a dev-dependency builds a package's library, not its
+/// binaries), and a binary left over from an earlier build may be stale.
+pub fn component_exe(package: &str, name: &str) -> PathBuf {
+    static BUILT: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+    let dir = tsukami_exe().parent().unwrap().to_owned();
+    let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
+    if !built.iter().any(|p| p == package) {
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+        let mut build = Command::new(cargo);
+        build.args(["build", "-p", package, "--bin", name]);
+        if dir.file_name().is_some_and(|d| d == "release") {
+            build.arg("--release");
+        }
+        let status = build.status().expect("running cargo build");
+        assert!(status.success(), "cargo build -p {package} failed");
+        built.push(package.to_owned());
+    }
+    dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX))
+}
+
 /// A child process killed when dropped.
 pub struct ChildGuard(pub Child);
 

@@ -1,7 +1,15 @@
-//! The `tsukami` binary: `tsukami run` serving, `tsukami plugins` listing it.
+//! The `tsukami` binary: `tsukami run` serving, `tsukami plugins` listing it,
+//! `tsukami view` drawing, and `tsukami demo` running the paper's scenes end to end
+//! (vision, grasp, motion, execution) with its components as child processes.
 
+use serde_json::Value;
+use std::path::Path;
 use tsukami::bus::free_loopback_port;
-use tsukami_e2e::{cli_plugins_listing, plugin_file, spawn_tsukami, tsukami_exe};
+use tsukami_body::kinematics::FkState;
+use tsukami_e2e::{
+    cli_plugins_listing, component_exe, models_dir, plugin_file, spawn_tsukami, tsukami_exe,
+};
+use tsukami_scenes::{scene_requests, World};
 
 #[test]
 fn plugins_lists_what_a_running_host_serves() {
@@ -101,21 +109,114 @@ fn view_draws_a_scene_headless_and_names_bad_arguments() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-#[test]
-fn demo_matches_the_paper_and_writes_its_report() {
-    let dir = std::env::temp_dir().join(format!("tsukami-demo-report-{}", std::process::id()));
+/// `tsukami demo --json --out DIR [extra]` with the component binaries built
+/// beside `tsukami`: its exit status, and its stdout parsed.
+fn demo_json(dir: &Path, extra: &[&str]) -> (bool, Vec<Value>) {
+    component_exe("tsukami-vision", "tsukami-vision");
+    component_exe("tsukami-controller", "tsukami-controller");
+    let mut args = vec!["demo", "--json", "--out", dir.to_str().unwrap()];
+    args.extend(extra);
     let out = std::process::Command::new(tsukami_exe())
-        .args(["demo", "--json", "--out", dir.to_str().unwrap()])
+        .args(&args)
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
+    let scenes: Value = serde_json::from_str(&stdout)
+        .unwrap_or_else(|e| panic!("{e}: {stdout}\n{}", String::from_utf8_lossy(&out.stderr)));
+    (out.status.success(), scenes.as_array().unwrap().clone())
+}
+
+/// The scene's world, rebuilt from its file (the robot model for FK and mimics).
+fn scene_world(name: &str) -> World {
+    let file = models_dir().join("scenes").join(format!("{name}.toml"));
+    let r = scene_requests(&file).unwrap();
+    World::from_requests(&models_dir(), &r.robot, &r.object, &r.env).unwrap()
+}
+
+/// The palm's pose with the joints of `state` (a joint map; others at rest).
+fn palm_at(world: &World, state: &Value) -> nalgebra::Isometry3<f64> {
+    let model = &world.robot.model;
+    let mut q = model.rest_positions();
+    for (name, value) in state.as_object().unwrap() {
+        q[model.joint_id(name).unwrap()] = value.as_f64().unwrap();
+    }
+    model.apply_mimics(&mut q);
+    let mut fk = FkState::new(model);
+    model.forward_kinematics(&q, &mut fk);
+    *fk.pose(world.robot.palm)
+}
+
+/// The vision found the object within 5 mm and 3° of the scene's pose, or said
+/// it did not find it: never a confident pose far off.
+fn check_vision(name: &str, vision: &Value) {
+    match vision["status"].as_str().unwrap() {
+        "ok" => assert_eq!(vision["within_tolerance"], true, "{name}: {vision}"),
+        "failed" => assert!(
+            vision["message"].as_str().unwrap().contains("not found"),
+            "{name}: {vision}"
+        ),
+        other => panic!("{name}: vision {other}: {vision}"),
+    }
+}
+
+/// The motion went from the controller's state through every phase; the
+/// controller ran it to the end; the state it published at the end of `close`
+/// is the planned grasp (every joint it drives; the others are mimic joints) and
+/// puts the palm where the planner said; the lift raised the palm.
+fn check_execution(name: &str, s: &Value) {
+    let motion = &s["motion"];
+    assert_eq!(motion["status"], "ok", "{name}: {motion}");
+    assert_eq!(motion["start_source"], "controller", "{name}");
+    assert_eq!(
+        motion["phases"],
+        serde_json::json!(["reach", "approach", "close", "lift"]),
+        "{name}"
     );
-    let scenes: serde_json::Value = serde_json::from_str(&stdout).unwrap();
-    let scenes = scenes.as_array().unwrap();
+    let execution = &s["execution"];
+    assert_eq!(execution["status"], "ok", "{name}: {execution}");
+    let (grasp, lift) = (&execution["grasp"], &execution["lift"]);
+    assert_eq!(grasp["outcome"], "done", "{name}");
+    assert_eq!(lift["outcome"], "done", "{name}");
+    let world = scene_world(name);
+    let model = &world.robot.model;
+    let not_driven = execution["joints_not_driven"].as_array().unwrap();
+    for (joint, planned) in s["result"]["joint_positions"].as_object().unwrap() {
+        let planned = planned.as_f64().unwrap();
+        match grasp["final_state"][joint].as_f64() {
+            Some(q) => assert!(
+                (q - planned).abs() <= 1e-6,
+                "{name}: {joint} ended at {q}, planned {planned}"
+            ),
+            None => {
+                assert!(
+                    not_driven.contains(&joint.as_str().into()),
+                    "{name}: {joint}"
+                );
+                let j = &model.joints[model.joint_id(joint).unwrap()];
+                assert!(
+                    j.mimic.is_some(),
+                    "{name}: {joint} is driven, but not by the controller"
+                );
+            }
+        }
+    }
+    let palm = palm_at(&world, &grasp["final_state"]);
+    let planned: Vec<f64> =
+        serde_json::from_value(s["result"]["palm_pose"]["position"].clone()).unwrap();
+    let off = (palm.translation.vector - nalgebra::Vector3::from_vec(planned)).norm();
+    assert!(
+        off < 1e-4,
+        "{name}: the executed palm is {:.3} mm from the plan",
+        off * 1e3
+    );
+    let risen = palm_at(&world, &lift["final_state"]).translation.z - palm.translation.z;
+    assert!(risen > 0.04, "{name}: the lift raised the palm {risen} m");
+}
+
+#[test]
+fn demo_matches_the_paper_and_writes_its_report() {
+    let dir = std::env::temp_dir().join(format!("tsukami-demo-report-{}", std::process::id()));
+    let (success, scenes) = demo_json(&dir, &["--speed", "50"]);
     let names: Vec<&str> = scenes
         .iter()
         .map(|s| s["scene"].as_str().unwrap())
@@ -131,11 +232,13 @@ fn demo_matches_the_paper_and_writes_its_report() {
         ]
     );
     let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
-    for s in scenes {
+    for s in &scenes {
         let name = s["scene"].as_str().unwrap();
         // `ok` is the paper check's verdict, recomputed from the reply's contacts.
         assert_eq!(s["ok"], true, "{name}: {}", s["problem"]);
         assert!(s["weight_scale"].as_f64().unwrap() >= 1.0, "{name}");
+        check_vision(name, &s["vision"]);
+        check_execution(name, s);
         assert!(report.contains(&format!(
             "| {name} | {} |",
             s["result"]["grasp_type"]["name"].as_str().unwrap()
@@ -149,5 +252,37 @@ fn demo_matches_the_paper_and_writes_its_report() {
             b"glTF"
         );
     }
+    assert!(success, "every scene passed, yet the demo failed");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn demo_without_its_components_runs_what_it_can() {
+    let dir = std::env::temp_dir().join(format!("tsukami-demo-alone-{}", std::process::id()));
+    let empty = dir.join("no-components");
+    std::fs::create_dir_all(&empty).unwrap();
+    let (success, scenes) = demo_json(
+        &dir,
+        &[
+            "--scene",
+            "can_waist",
+            "--components-dir",
+            empty.to_str().unwrap(),
+        ],
+    );
+    assert!(success, "missing components are not run, not failed");
+    let s = &scenes[0];
+    assert_eq!(s["ok"], true, "{}", s["problem"]);
+    for step in ["vision", "execution"] {
+        assert_eq!(s[step]["status"], "not_run", "{step}: {}", s[step]);
+        let message = s[step]["message"].as_str().unwrap();
+        assert!(
+            message.contains("not found in") && message.contains("cargo build"),
+            "{message}"
+        );
+    }
+    // The motion is planned all the same, from the rest posture.
+    assert_eq!(s["motion"]["status"], "ok", "{}", s["motion"]);
+    assert_eq!(s["motion"]["start_source"], "rest");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -15,14 +15,14 @@
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
-use std::sync::{mpsc, Mutex};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 use tsukami::bus::{free_loopback_port, BusConfig};
 use tsukami::client::{BusClient, RequestError};
 use tsukami_bus::ComponentArgs;
 use tsukami_e2e::mocks::{MockController, MockVision};
 use tsukami_e2e::{
-    models_dir, planner_entry, plugin_file, spawn_tsukami, test_config, tsukami_exe, ChildGuard,
+    component_exe, models_dir, planner_entry, plugin_file, spawn_tsukami, test_config, ChildGuard,
     TestBus,
 };
 use tsukami_msgs::controller::{ControllerState, ExecuteReply, ExecutionOutcome};
@@ -128,28 +128,6 @@ fn wait_for_router(client: &BusConfig) {
         assert!(start.elapsed() < T, "the router never came up");
         std::thread::sleep(Duration::from_millis(50));
     }
-}
-
-/// The binary `name` of package `package`, brought up to date by `cargo build`
-/// once per test process: `cargo test -p tsukami-e2e` builds this package's
-/// binaries only (a dev-dependency builds a package's library, not its binaries),
-/// and a binary left over from an earlier build may be stale.
-fn component_exe(package: &str, name: &str) -> PathBuf {
-    static BUILT: Mutex<Vec<String>> = Mutex::new(Vec::new());
-    let dir = tsukami_exe().parent().unwrap().to_owned();
-    let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
-    if !built.iter().any(|p| p == package) {
-        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-        let mut build = Command::new(cargo);
-        build.args(["build", "-p", package, "--bin", name]);
-        if dir.file_name().is_some_and(|d| d == "release") {
-            build.arg("--release");
-        }
-        let status = build.status().expect("running cargo build");
-        assert!(status.success(), "cargo build -p {package} failed");
-        built.push(package.to_owned());
-    }
-    dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX))
 }
 
 fn controller_exe() -> PathBuf {

@@ -1,5 +1,6 @@
 //! The demo's report: a Markdown page with one row and one picture per scene,
-//! beside each scene's picture (`SCENE.png`) and glTF binary (`SCENE.glb`).
+//! beside each scene's picture (`SCENE.png`) and glTF binary (`SCENE.glb`); the
+//! components' logs are in `logs/` beside them.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -8,36 +9,37 @@ use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use tsukami_scenes::{scene_requests, World};
 
-use crate::demo::cells;
+use crate::demo::{plan_cells, step_cells, DemoScene};
 use crate::picture::{write_pictures, DEFAULT_EYE};
-use crate::scenes::SceneOutcome;
 
 /// Picture size of the report (pixels).
 const PICTURE: (u32, u32) = (800, 600);
 
-/// Writes the report of `outcomes` into `dir` (created if needed); returns the
+/// Writes the report of `scenes` into `dir` (created if needed); returns the
 /// Markdown file's path.
-pub fn write_report(
-    dir: &Path,
-    models: &Path,
-    outcomes: &[SceneOutcome],
-    seed: u64,
-) -> Result<PathBuf> {
+pub fn write_report(dir: &Path, models: &Path, scenes: &[DemoScene], seed: u64) -> Result<PathBuf> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut md = format!(
-        "# Tsukami demo report\n\nThe paper's scenes planned over the bus (seed {seed}). \
-         \"exact\" is the independent check's verdict (force closure with the object's \
-         weight, recomputed from the reply's contacts).\n\n\
-         | scene | grasp type | region:face | whole-body joints | margin | exact | plan ms | paper |\n\
-         |---|---|---|---|---|---|---|---|\n"
+        "# Tsukami demo report\n\nThe paper's scenes run over the bus (seed {seed}): the \
+         vision component finds the object (error against the scene file's pose), the grasp \
+         planner plans on the scene file's pose, the trajectory planner plans rest → grasp → \
+         lift, the controller executes it. \"exact\" is the independent check's verdict \
+         (force closure with the object's weight, recomputed from the reply's contacts); \
+         \"executed\" is ok when the controller's published state at the end of `close` \
+         is the planned grasp posture and at the end of the lift the trajectory's last \
+         point (within 1e-6).\n\n\
+         | scene | grasp type | region:face | whole-body joints | margin | exact | vision error | plan ms | motion ms | motion s | executed | paper |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|\n"
     );
     let mut pictures = String::new();
-    for o in outcomes {
-        let [grasp, face, joints, margin, exact] = cells(o);
+    for scene in scenes {
+        let o = &scene.plan;
+        let [grasp, face, joints, margin, exact] = plan_cells(o);
+        let [vision, motion_ms, motion_s, executed] = step_cells(scene);
         let verdict = if o.ok { "ok" } else { "DIFFERS" };
         writeln!(
             md,
-            "| {} | {grasp} | {face} | {joints} | {margin} | {exact} | {:.1} | {verdict}: {} |",
+            "| {} | {grasp} | {face} | {joints} | {margin} | {exact} | {vision} | {:.1} | {motion_ms} | {motion_s} | {executed} | {verdict}: {} |",
             o.scene, o.plan_ms, o.expected
         )?;
         let scene = models.join("scenes").join(format!("{}.toml", o.scene));
