@@ -1,8 +1,10 @@
 //! Project tasks behind cargo aliases (see `.cargo/config.toml`).
 //!
 //! `cargo demo [ARGS]`: builds every crate of the workspace in release mode — the
-//! host binary *and* the plugin libraries, which `cargo run -p tsukami` alone would
-//! not build — then runs `target/release/tsukami demo [ARGS]`.
+//! host binary, the plugin libraries and the component binaries (`tsukami-vision`,
+//! `tsukami-controller`), which `cargo run -p tsukami` alone would not build — then
+//! runs `target/release/tsukami demo [ARGS]`, which finds the components beside
+//! itself.
 
 use std::process::{Command, ExitCode};
 

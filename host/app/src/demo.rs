@@ -34,7 +34,7 @@ pub mod step;
 mod table;
 pub mod vision;
 
-pub(crate) use table::{plan_cells, step_cells};
+pub(crate) use table::{notes, plan_cells, step_cells};
 
 use crate::bus::{free_loopback_port, BusConfig};
 use crate::client::BusClient;

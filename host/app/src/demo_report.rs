@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use tsukami_scenes::{scene_requests, World};
 
-use crate::demo::{plan_cells, step_cells, DemoScene};
+use crate::demo::{notes, plan_cells, step_cells, DemoScene};
 use crate::picture::{write_pictures, DEFAULT_EYE};
 
 /// Picture size of the report (pixels).
@@ -42,8 +42,8 @@ pub fn write_report(dir: &Path, models: &Path, scenes: &[DemoScene], seed: u64) 
             "| {} | {grasp} | {face} | {joints} | {margin} | {exact} | {vision} | {:.1} | {motion_ms} | {motion_s} | {executed} | {verdict}: {} |",
             o.scene, o.plan_ms, o.expected
         )?;
-        let scene = models.join("scenes").join(format!("{}.toml", o.scene));
-        let req = scene_requests(&scene).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let file = models.join("scenes").join(format!("{}.toml", o.scene));
+        let req = scene_requests(&file).map_err(|e| anyhow::anyhow!("{e}"))?;
         let world = World::from_requests(models, &req.robot, &req.object, &req.env)
             .map_err(|e| anyhow::anyhow!("scene {}: {e}", o.scene))?;
         let (png, glb) = (format!("{}.png", o.scene), format!("{}.glb", o.scene));
@@ -55,10 +55,15 @@ pub fn write_report(dir: &Path, models: &Path, scenes: &[DemoScene], seed: u64) 
             PICTURE,
             Vector3::from(DEFAULT_EYE),
         )?;
+        writeln!(pictures, "## {}\n", o.scene)?;
+        for note in notes(scene) {
+            writeln!(pictures, "- {note}")?;
+        }
         writeln!(
             pictures,
-            "## {}\n\n![{}]({png})\n\n3D: [{glb}]({glb})\n",
-            o.scene, o.scene
+            "\n![{}]({png})\n\n3D: [{glb}]({glb}); the components' output: \
+             [vision](logs/vision-{}.log), [controller](logs/controller-{}.log)\n",
+            o.scene, o.scene, o.scene
         )?;
     }
     md.push('\n');
