@@ -15,10 +15,10 @@
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
-use std::sync::mpsc;
 use std::time::{Duration, Instant};
 use tsukami::bus::{free_loopback_port, BusConfig};
 use tsukami::client::{BusClient, RequestError};
+use tsukami::demo::motion::StateStream;
 use tsukami_bus::ComponentArgs;
 use tsukami_e2e::mocks::{MockController, MockVision};
 use tsukami_e2e::{
@@ -353,18 +353,14 @@ fn execute(
 
 /// Runs `trajectory` and checks that the reply and the last published state end at
 /// its last point.
-fn execute_to_the_end(
-    client: &BusClient,
-    states: &mpsc::Receiver<ControllerState>,
-    trajectory: &JointTrajectory,
-) {
+fn execute_to_the_end(client: &BusClient, states: &StateStream, trajectory: &JointTrajectory) {
     let reply = execute(client, trajectory, T).unwrap();
     assert!(reply.accepted, "{:?}", reply.reason);
     assert_eq!(reply.outcome, Some(ExecutionOutcome::Done));
     let goal = &trajectory.points[1].positions;
     let end = reply.state.unwrap();
     let last_published = loop {
-        let state = states.recv_timeout(T).expect("states are published");
+        let state = states.next(T).expect("states are published");
         if state.tick == end.tick {
             break state;
         }
@@ -375,28 +371,6 @@ fn execute_to_the_end(
         assert!((end.positions[i] - want).abs() < 1e-6, "{name}");
         assert!((last_published.positions[i] - want).abs() < 1e-6, "{name}");
     }
-}
-
-fn state_stream(
-    client: &BusClient,
-) -> (
-    zenoh::pubsub::Subscriber<()>,
-    mpsc::Receiver<ControllerState>,
-) {
-    let (tx, rx) = mpsc::channel();
-    let tx = std::sync::Mutex::new(tx);
-    let subscriber = zenoh::Wait::wait(
-        client
-            .session()
-            .declare_subscriber(client.keys().controller_state())
-            .callback(move |sample| {
-                if let Ok(state) = serde_json::from_slice(&sample.payload().to_bytes()) {
-                    let _ = tx.lock().unwrap().send(state);
-                }
-            }),
-    )
-    .unwrap();
-    (subscriber, rx)
 }
 
 /// The whole run over `t`.
@@ -410,7 +384,7 @@ fn vision_plan_execute_kill_restart(t: Topology) {
     let info = client.wait_for_component("controller", T).unwrap();
     assert_eq!(info.version, env!("CARGO_PKG_VERSION"));
     client.wait_for_component("vision", T).unwrap();
-    let (_sub, states) = state_stream(&client);
+    let states = StateStream::subscribe(&client).unwrap();
 
     let (detected, goal) = detect_and_plan(&client, &scene);
     let (dist, angle) = can_error(&detected, &scene.object.pose);
@@ -431,7 +405,7 @@ fn vision_plan_execute_kill_restart(t: Topology) {
     let started = Instant::now();
     let failed = std::thread::scope(|s| {
         let request = s.spawn(|| execute(&client, &back, timeout));
-        while states.recv_timeout(T).expect("states").status != "executing" {}
+        while states.next(T).expect("states").status != "executing" {}
         controller.0.kill().unwrap();
         controller.0.wait().unwrap();
         request.join().unwrap()

@@ -301,14 +301,15 @@ fn outcome_name(outcome: Option<ExecutionOutcome>) -> String {
     .to_owned()
 }
 
-/// The controller's published states, as they arrive.
-struct StateStream {
+/// The controller's published states (`<ns>/controller/state`), as they arrive.
+pub struct StateStream {
     _subscriber: zenoh::pubsub::Subscriber<()>,
     states: mpsc::Receiver<ControllerState>,
 }
 
 impl StateStream {
-    fn subscribe(client: &BusClient) -> Result<StateStream, String> {
+    /// Subscribes on `client`'s session.
+    pub fn subscribe(client: &BusClient) -> Result<StateStream, String> {
         let (tx, states) = mpsc::channel();
         let tx = std::sync::Mutex::new(tx);
         let subscriber = zenoh::Wait::wait(
@@ -328,15 +329,20 @@ impl StateStream {
         })
     }
 
+    /// The next published state, or none within `timeout`.
+    pub fn next(&self, timeout: Duration) -> Option<ControllerState> {
+        self.states.recv_timeout(timeout).ok()
+    }
+
     /// The first published state of control period `tick` or later.
-    fn at_or_after(&self, tick: u64) -> Result<ControllerState, String> {
+    pub fn at_or_after(&self, tick: u64) -> Result<ControllerState, String> {
         let start = Instant::now();
         loop {
             let left = STATE_WAIT.saturating_sub(start.elapsed());
-            match self.states.recv_timeout(left) {
-                Ok(state) if state.tick >= tick => return Ok(state),
-                Ok(_) => continue,
-                Err(_) => {
+            match self.next(left) {
+                Some(state) if state.tick >= tick => return Ok(state),
+                Some(_) => continue,
+                None => {
                     return Err(format!(
                         "no state of period {tick} or later published within {STATE_WAIT:?}"
                     ))
