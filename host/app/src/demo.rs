@@ -50,6 +50,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use step::Step;
+use tsukami_msgs::host::PluginsReply;
 use tsukami_msgs::planner::ObjectShape;
 use tsukami_scenes::{scene_requests, PaperScene, PAPER_SCENES};
 use vision::VisionCheck;
@@ -170,12 +171,7 @@ pub fn run(args: &DemoArgs) -> Result<ExitCode> {
             "Tsukami host on {host_endpoint}, namespace `{}`, ready in {ready_ms:.0} ms; plugins:",
             config.namespace
         );
-        for plugin in &listing.plugins {
-            let roles = plugin.roles.join(",");
-            println!("  {roles:<20} {} {}", plugin.name, plugin.version);
-        }
-        demo.print_components();
-        println!("\n{}", table::header());
+        demo.print_header(&listing);
     }
     let mut results = Vec::new();
     for scene in scenes {
@@ -260,7 +256,12 @@ struct Demo<'a> {
 }
 
 impl Demo<'_> {
-    fn print_components(&self) {
+    /// The plugins, the components, and the table's header.
+    fn print_header(&self, listing: &PluginsReply) {
+        for plugin in &listing.plugins {
+            let roles = plugin.roles.join(",");
+            println!("  {roles:<20} {} {}", plugin.name, plugin.version);
+        }
         println!("Components, started for each scene on the same bus:");
         let rows = [
             ("vision", &self.vision_exe, "simulated head camera"),
@@ -280,6 +281,7 @@ impl Demo<'_> {
         println!(
             "Grasps are planned on each scene file's object pose; the vision error is measured against it."
         );
+        println!("\n{}", table::header());
     }
 
     /// Starts component `name` for `scene` with `args` after the bus options.

@@ -129,7 +129,8 @@ enum Command {
         #[arg(long, default_value = "docs/schema")]
         out: PathBuf,
     },
-    /// Run the main job: start a private host with its plugins and show it working.
+    /// Run the main job: the paper's scenes end to end (vision, grasp, motion,
+    /// execution) on a private host with its plugins and the components.
     Demo(tsukami::demo::DemoArgs),
     /// Robot models: inspect, forward and inverse kinematics.
     Model {
