@@ -30,8 +30,21 @@
 //! tolerance, see `tests/fast_distance.rs`);
 //! [`RobotCollision::set_distance_method`] selects parry's path for
 //! everything (the reference, for tests and benchmarks).
+//!
+//! # Broad phase
+//! Every pair test starts with the two parts' world AABBs (parry's own, so
+//! as tight as parry makes them). A [`Placement`] holds them for one
+//! configuration — each part's world pose and AABB, and each link's AABB
+//! (the union of its parts') — so a caller that tests many pairs at one
+//! configuration computes every AABB once, not once per pair, and skips a
+//! link pair whose link AABBs are apart before looking at its parts
+//! ([`RobotCollision::place`], [`RobotCollision::placed_self_collision`],
+//! [`RobotCollision::placed_collision`]). A [`CollisionObject`] keeps its
+//! parts' world AABBs from one `set_pose` to the next. The broad phase only
+//! skips pairs that cannot collide: every answer is the narrow phase's.
 
 use nalgebra::{Isometry3, Point3, Unit, UnitQuaternion, Vector3};
+use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Pose;
 use parry3d_f64::query::{self, ClosestPoints};
 use parry3d_f64::shape::{SharedShape, TriMesh, TriMeshFlags};
@@ -126,6 +139,42 @@ pub fn build_trimesh(mesh: &TriangleMesh) -> std::result::Result<(TriMesh, bool)
         .map_err(|e| format!("cannot build the collision mesh: {e}"))
 }
 
+/// A part at its world pose, with its world AABB.
+#[derive(Debug, Clone, Copy)]
+struct Placed {
+    pose: Pose,
+    aabb: Aabb,
+}
+
+impl Placed {
+    /// `part` of an owner at `pose`.
+    fn new(pose: &Pose, part: &Part) -> Self {
+        let pose = *pose * part.origin;
+        Placed {
+            aabb: part.shape.compute_aabb(&pose),
+            pose,
+        }
+    }
+}
+
+/// Do two AABBs come within `margin` of each other? (False when either is
+/// empty or not finite.)
+fn overlap(a: &Aabb, b: &Aabb, margin: f64) -> bool {
+    a.mins.x <= b.maxs.x + margin
+        && b.mins.x <= a.maxs.x + margin
+        && a.mins.y <= b.maxs.y + margin
+        && b.mins.y <= a.maxs.y + margin
+        && a.mins.z <= b.maxs.z + margin
+        && b.mins.z <= a.maxs.z + margin
+}
+
+/// The AABB of placed parts (empty — overlapping nothing — for none).
+fn union(parts: &[Placed]) -> Aabb {
+    parts.iter().fold(Aabb::new_invalid(), |acc, p| {
+        Aabb::new(acc.mins.min(p.aabb.mins), acc.maxs.max(p.aabb.maxs))
+    })
+}
+
 /// A rigid collision body with a world pose: an object or an obstacle.
 #[derive(Debug, Clone)]
 pub struct CollisionObject {
@@ -134,17 +183,32 @@ pub struct CollisionObject {
     pose: Isometry3<f64>,
     parry_pose: Pose,
     parts: Vec<Part>,
+    /// The parts at `pose`, and their AABB.
+    placed: Vec<Placed>,
+    bounds: Aabb,
 }
 
 impl CollisionObject {
     /// An object made of shapes placed in its frame, at `pose` in the world.
     pub fn new(name: impl Into<String>, pose: Isometry3<f64>, parts: Vec<Part>) -> Self {
-        Self {
+        let mut me = Self {
             name: name.into(),
             parry_pose: to_pose(&pose),
             pose,
             parts,
-        }
+            placed: Vec::new(),
+            bounds: Aabb::new_invalid(),
+        };
+        me.place();
+        me
+    }
+
+    fn place(&mut self) {
+        self.placed.clear();
+        let pose = self.parry_pose;
+        self.placed
+            .extend(self.parts.iter().map(|p| Placed::new(&pose, p)));
+        self.bounds = union(&self.placed);
     }
 
     /// An object whose single shape is a triangle mesh (in the object frame).
@@ -174,6 +238,13 @@ impl CollisionObject {
     pub fn set_pose(&mut self, pose: Isometry3<f64>) {
         self.pose = pose;
         self.parry_pose = to_pose(&pose);
+        self.place();
+    }
+
+    /// The world axis-aligned box holding every part, as (min, max) corners
+    /// (min > max on some axis when the object has no part).
+    pub fn bounds(&self) -> (Point3<f64>, Point3<f64>) {
+        (to_point(self.bounds.mins), to_point(self.bounds.maxs))
     }
 
     /// The shapes.
@@ -215,17 +286,15 @@ impl CollisionObject {
     /// Do the two objects come closer than `margin` (or overlap, or one lie
     /// inside the other's closed mesh)?
     pub fn intersects(&self, other: &CollisionObject, margin: f64) -> bool {
-        self.parts.iter().any(|a| {
-            other.parts.iter().any(|b| {
-                pair_collides(
-                    DistanceMethod::Parry,
-                    &self.parry_pose,
-                    a,
-                    &other.parry_pose,
-                    b,
-                    margin,
-                )
-            })
+        if !overlap(&self.bounds, &other.bounds, margin) {
+            return false;
+        }
+        self.parts.iter().zip(&self.placed).any(|(a, pa)| {
+            other
+                .parts
+                .iter()
+                .zip(&other.placed)
+                .any(|(b, pb)| placed_collides(DistanceMethod::Parry, pa, a, pb, b, margin))
         })
     }
 
@@ -382,29 +451,23 @@ fn penetration(w1: &Pose, p1: &Part, w2: &Pose, p2: &Part) -> Option<PairProximi
 fn aabbs_overlap(pose1: &Pose, p1: &Part, pose2: &Pose, p2: &Part, margin: f64) -> bool {
     let a = p1.shape.compute_aabb(&(*pose1 * p1.origin));
     let b = p2.shape.compute_aabb(&(*pose2 * p2.origin));
-    a.mins.x <= b.maxs.x + margin
-        && b.mins.x <= a.maxs.x + margin
-        && a.mins.y <= b.maxs.y + margin
-        && b.mins.y <= a.maxs.y + margin
-        && a.mins.z <= b.maxs.z + margin
-        && b.mins.z <= a.maxs.z + margin
+    overlap(&a, &b, margin)
 }
 
-/// Do two placed parts collide, i.e. come closer than `margin` (or overlap,
-/// or one lies inside the other's closed mesh)?
-fn pair_collides(
+/// Do two parts (`p1` placed as `a`, `p2` as `b`) collide, i.e. come closer
+/// than `margin` (or overlap, or one lies inside the other's closed mesh)?
+fn placed_collides(
     method: DistanceMethod,
-    pose1: &Pose,
+    a: &Placed,
     p1: &Part,
-    pose2: &Pose,
+    b: &Placed,
     p2: &Part,
     margin: f64,
 ) -> bool {
-    if !aabbs_overlap(pose1, p1, pose2, p2, margin) {
+    if !overlap(&a.aabb, &b.aabb, margin) {
         return false;
     }
-    let w1 = *pose1 * p1.origin;
-    let w2 = *pose2 * p2.origin;
+    let (w1, w2) = (a.pose, b.pose);
     let hit = if let Some(cp) = fast_closest_points(method, &w1, p1, &w2, p2, margin.max(0.0)) {
         // Margin 0 accepts only overlaps, like parry's intersection test.
         !matches!(cp, ClosestPoints::Disjoint)
@@ -422,13 +485,10 @@ fn pair_collides(
         return true;
     }
     // A shape wholly inside a closed mesh does not touch its surface.
-    let inside = |wa: &Pose, pa: &Part, wb: &Pose, pb: &Part| {
-        pb.solid_mesh
-            && pb
-                .shape
-                .contains_point(wb, pa.shape.compute_aabb(wa).center())
+    let inside = |a: &Placed, b: &Placed, pb: &Part| {
+        pb.solid_mesh && pb.shape.contains_point(&b.pose, a.aabb.center())
     };
-    inside(&w1, p1, &w2, p2) || inside(&w2, p2, &w1, p1)
+    inside(a, b, p2) || inside(b, a, p1)
 }
 
 /// How deep one placed part sinks into another: 0 when they are apart or
@@ -624,26 +684,9 @@ impl RobotCollision {
         objects: &[&CollisionObject],
         margin: f64,
     ) -> Option<Hit> {
-        for &link in links {
-            let link_pose = to_pose(fk.pose(link));
-            for (o, object) in objects.iter().enumerate() {
-                for lp in &self.parts[link] {
-                    for op in &object.parts {
-                        if pair_collides(
-                            self.method,
-                            &link_pose,
-                            lp,
-                            &object.parry_pose,
-                            op,
-                            margin,
-                        ) {
-                            return Some(Hit { link, object: o });
-                        }
-                    }
-                }
-            }
-        }
-        None
+        let mut placement = Placement::default();
+        self.place(fk, links, &mut placement);
+        self.placed_collision(&placement, links, objects, margin)
     }
 
     /// How deep `link` sinks into `object` (0 when apart or only touching):
@@ -710,27 +753,120 @@ impl RobotCollision {
         margin: f64,
         first: bool,
     ) -> Vec<(LinkId, LinkId)> {
+        let mut placement = Placement::default();
+        self.place(fk, &self.with_geometry, &mut placement);
         let mut out = Vec::new();
-        for (ia, &a) in self.with_geometry.iter().enumerate() {
-            let pa = to_pose(fk.pose(a));
-            for &b in &self.with_geometry[ia + 1..] {
-                if self.is_allowed(a, b) {
-                    continue;
-                }
-                let pb = to_pose(fk.pose(b));
-                let hit = self.parts[a].iter().any(|x| {
-                    self.parts[b]
-                        .iter()
-                        .any(|y| pair_collides(self.method, &pa, x, &pb, y, margin))
-                });
-                if hit {
-                    out.push((a, b));
-                    if first {
-                        return out;
-                    }
+        for (a, b) in self.self_pairs() {
+            if self.placed_pair_collides(&placement, a, b, margin) {
+                out.push((a, b));
+                if first {
+                    break;
                 }
             }
         }
         out
     }
+
+    /// Every pair of links with geometry not allowed to touch, each once as
+    /// `(a, b)` with `a < b`, in the order the self-collision queries test them.
+    pub fn self_pairs(&self) -> Vec<(LinkId, LinkId)> {
+        let g = &self.with_geometry;
+        g.iter()
+            .enumerate()
+            .flat_map(|(i, &a)| g[i + 1..].iter().map(move |&b| (a, b)))
+            .filter(|&(a, b)| !self.is_allowed(a, b))
+            .collect()
+    }
+
+    /// Places the parts of `links` for the configuration in `fk` (world poses
+    /// and AABBs) into `placement`; other links keep what it held.
+    pub fn place(&self, fk: &FkState, links: &[LinkId], placement: &mut Placement) {
+        placement.parts.resize_with(self.n, Vec::new);
+        placement.bounds.resize(self.n, Aabb::new_invalid());
+        for &link in links {
+            let pose = to_pose(fk.pose(link));
+            let placed = &mut placement.parts[link];
+            placed.clear();
+            placed.extend(self.parts[link].iter().map(|p| Placed::new(&pose, p)));
+            placement.bounds[link] = union(placed);
+        }
+    }
+
+    /// Do the placed links `a` and `b` come closer than `margin` (whether
+    /// the pair is allowed is the caller's business)?
+    fn placed_pair_collides(
+        &self,
+        placement: &Placement,
+        a: LinkId,
+        b: LinkId,
+        margin: f64,
+    ) -> bool {
+        if !overlap(&placement.bounds[a], &placement.bounds[b], margin) {
+            return false;
+        }
+        let (pa, pb) = (&placement.parts[a], &placement.parts[b]);
+        self.parts[a].iter().zip(pa).any(|(x, xa)| {
+            self.parts[b]
+                .iter()
+                .zip(pb)
+                .any(|(y, yb)| placed_collides(self.method, xa, x, yb, y, margin))
+        })
+    }
+
+    /// [`Self::first_self_collision`] over the placed links: the first of
+    /// `pairs` (e.g. a subset of [`Self::self_pairs`]) whose links come
+    /// closer than `margin`. Every link of `pairs` must be placed.
+    pub fn placed_self_collision(
+        &self,
+        placement: &Placement,
+        pairs: &[(LinkId, LinkId)],
+        margin: f64,
+    ) -> Option<(LinkId, LinkId)> {
+        pairs
+            .iter()
+            .copied()
+            .find(|&(a, b)| self.placed_pair_collides(placement, a, b, margin))
+    }
+
+    /// [`Self::first_collision`] over the placed links: the first of `links`
+    /// (each placed) that comes closer than `margin` to one of `objects`.
+    pub fn placed_collision(
+        &self,
+        placement: &Placement,
+        links: &[LinkId],
+        objects: &[&CollisionObject],
+        margin: f64,
+    ) -> Option<Hit> {
+        for &link in links {
+            let bounds = &placement.bounds[link];
+            for (o, object) in objects.iter().enumerate() {
+                if !overlap(bounds, &object.bounds, margin) {
+                    continue;
+                }
+                let hit =
+                    self.parts[link]
+                        .iter()
+                        .zip(&placement.parts[link])
+                        .any(|(lp, la)| {
+                            object.parts.iter().zip(&object.placed).any(|(op, oa)| {
+                                placed_collides(self.method, la, lp, oa, op, margin)
+                            })
+                        });
+                if hit {
+                    return Some(Hit { link, object: o });
+                }
+            }
+        }
+        None
+    }
+}
+
+/// The collision parts of a robot's links placed for one configuration
+/// ([`RobotCollision::place`]): each part's world pose and AABB and each
+/// link's AABB, computed once and shared by every pair test at that
+/// configuration.
+#[derive(Debug, Clone, Default)]
+pub struct Placement {
+    parts: Vec<Vec<Placed>>,
+    bounds: Vec<Aabb>,
 }

@@ -22,16 +22,19 @@
 //! moving with the hand, checked against the obstacles and the rest of the robot).
 //! [`RobotWorld::first_hit`] names what collides. The first check of a world
 //! covers every link; later ones only the links the planned joints move (the
-//! others keep the pose the first check saw), and only link pairs one of which
-//! moves; pairs whose bounding spheres (about the link frames) are apart skip the
+//! others keep the pose the first check saw), and only link pairs that move
+//! relative to each other (two links past the same last planned joint — the
+//! fingers of a hand the reach carries — keep the relative pose the first
+//! check saw). Each check places the links once (world pose and AABB of every part,
+//! `tsukami_body::collision::Placement`); pairs whose AABBs are apart skip the
 //! exact test. Every check is counted.
 
 use nalgebra::{Isometry3, Vector3};
-use tsukami_body::collision::{CollisionObject, RobotCollision};
+use tsukami_body::collision::{CollisionObject, Placement, RobotCollision};
 use tsukami_body::kinematics::FkState;
 use tsukami_body::model::{JointId, LinkId, RobotModel};
 
-use crate::resolution::{link_radius, SweepBound};
+use crate::resolution::SweepBound;
 use crate::rrt_connect::{SegmentSteps, Validity};
 
 /// Default largest travel of any link point between two checks of a segment:
@@ -42,17 +45,17 @@ pub const DEFAULT_MAX_TRAVEL: f64 = 0.005;
 pub struct RobotWorld<'a> {
     model: &'a RobotModel,
     collision: &'a RobotCollision,
-    /// `collision` with the pairs of links the planned joints never move
-    /// relative to each other allowed: every check after the first.
-    moving_pairs: RobotCollision,
+    /// The link pairs checked for self-collision at the first check.
+    all_pairs: Vec<(LinkId, LinkId)>,
+    /// Those whose links the planned joints move relative to each other: every
+    /// check after the first.
+    moving_pairs: Vec<(LinkId, LinkId)>,
     obstacles: Vec<&'a CollisionObject>,
     links: Vec<LinkId>,
     /// Links with geometry that the planned joints move.
     moving: Vec<LinkId>,
-    /// Per link: radius of a sphere about its frame origin holding its geometry.
-    radius: Vec<f64>,
-    /// Per obstacle: a bounding sphere (centre, radius).
-    spheres: Vec<(Vector3<f64>, f64)>,
+    /// The links' parts at the configuration checked last.
+    placement: Placement,
     joints: Vec<JointId>,
     base: Vec<f64>,
     margin: f64,
@@ -62,7 +65,11 @@ pub struct RobotWorld<'a> {
     scratch: Vec<f64>,
     checks: usize,
     object: Option<ObjectRule<'a>>,
+    /// Links that may not touch the object (all; moving), with `object`.
+    strict: [Vec<LinkId>; 2],
     attached: Option<Attached>,
+    /// Links checked against the attached object, with `attached`.
+    carrying: Vec<LinkId>,
 }
 
 /// The object to grasp as a body some hand links may touch.
@@ -128,24 +135,24 @@ impl<'a> RobotWorld<'a> {
         let links: Vec<LinkId> = (0..model.links.len())
             .filter(|&l| !collision.link_parts(l).is_empty())
             .collect();
-        let moved = moved_links(model, &joints);
-        let moving = links.iter().copied().filter(|&l| moved[l]).collect();
-        let mut moving_pairs = collision.clone();
-        for &a in &links {
-            for &b in &links {
-                if !moved[a] && !moved[b] {
-                    moving_pairs.allow(a, b);
-                }
-            }
-        }
+        let moved = moving_bodies(model, &joints);
+        let moving = links
+            .iter()
+            .copied()
+            .filter(|&l| moved[l].is_some())
+            .collect();
+        let all_pairs = collision.self_pairs();
+        let moving_pairs = all_pairs
+            .iter()
+            .copied()
+            .filter(|&(a, b)| moved[a] != moved[b])
+            .collect();
         RobotWorld {
             model,
             collision,
+            all_pairs,
             moving_pairs,
-            radius: (0..model.links.len())
-                .map(|l| link_radius(model, l))
-                .collect(),
-            spheres: obstacles.iter().map(|o| bounding_sphere(o)).collect(),
+            placement: Placement::default(),
             obstacles,
             links,
             moving,
@@ -158,12 +165,22 @@ impl<'a> RobotWorld<'a> {
             fk: FkState::new(model),
             checks: 0,
             object: None,
+            strict: [Vec::new(), Vec::new()],
             attached: None,
+            carrying: Vec::new(),
         }
     }
 
     /// Adds the object to grasp, which `rule.touching` links may touch.
     pub fn with_object(mut self, rule: ObjectRule<'a>) -> Self {
+        let strict = |links: &[LinkId]| {
+            links
+                .iter()
+                .copied()
+                .filter(|l| !rule.touching.contains(l))
+                .collect()
+        };
+        self.strict = [strict(&self.links), strict(&self.moving)];
         self.object = Some(rule);
         self
     }
@@ -172,6 +189,12 @@ impl<'a> RobotWorld<'a> {
     /// the object's reach from that link.
     pub fn with_attached(mut self, attached: Attached) -> Self {
         self.sweep = SweepBound::with_attached(self.model, &[(attached.link, attached.radius)]);
+        self.carrying = self
+            .links
+            .iter()
+            .copied()
+            .filter(|l| !attached.holding.contains(l))
+            .collect();
         self.attached = Some(attached);
         self
     }
@@ -248,77 +271,43 @@ impl RobotWorld<'_> {
         self.model.forward_kinematics(&self.scratch, &mut self.fk);
         let name = |l: LinkId| self.model.links[l].name.clone();
         // Links the planned joints do not move stay where the first check saw them.
-        let (pairs, links) = if self.checks == 1 {
-            (self.collision, &self.links)
+        let first = self.checks == 1;
+        let (pairs, links) = if first {
+            (&self.all_pairs, &self.links)
         } else {
-            self.prune_pairs();
             (&self.moving_pairs, &self.moving)
         };
-        if let Some((a, b)) = pairs.first_self_collision(&self.fk, self.margin) {
+        self.collision.place(&self.fk, links, &mut self.placement);
+        if let Some((a, b)) =
+            self.collision
+                .placed_self_collision(&self.placement, pairs, self.margin)
+        {
             return Some(Collision {
                 link: name(a),
                 with: format!("link `{}`", name(b)),
             });
         }
-        for (o, &(centre, r)) in self.spheres.iter().enumerate() {
-            // Broad phase: only links whose bounding sphere reaches the obstacle's.
-            let near: Vec<LinkId> = links
-                .iter()
-                .copied()
-                .filter(|&l| {
-                    (self.fk.pose(l).translation.vector - centre).norm()
-                        <= r + self.radius[l] + self.margin
-                })
-                .collect();
-            let body = [self.obstacles[o]];
-            if let Some(hit) = self
-                .collision
-                .first_collision(&self.fk, &near, &body, self.margin)
+        for body in &self.obstacles {
+            if let Some(hit) =
+                self.collision
+                    .placed_collision(&self.placement, links, &[*body], self.margin)
             {
                 return Some(Collision {
                     link: name(hit.link),
-                    with: format!("obstacle `{}`", body[0].name),
+                    with: format!("obstacle `{}`", body.name),
                 });
             }
         }
-        self.object_hit().or_else(|| self.attached_hit())
+        self.object_hit(first).or_else(|| self.attached_hit())
     }
 
-    /// Broad phase: of the pairs with a moving link that may not touch, only
-    /// those whose bounding spheres overlap go to the exact test.
-    fn prune_pairs(&mut self) {
-        for &a in &self.moving {
-            let pa = self.fk.pose(a).translation.vector;
-            for &b in &self.links {
-                if self.collision.is_allowed(a, b) {
-                    continue;
-                }
-                let d = (self.fk.pose(b).translation.vector - pa).norm();
-                if d <= self.radius[a] + self.radius[b] + self.margin {
-                    self.moving_pairs.disallow(a, b);
-                } else {
-                    self.moving_pairs.allow(a, b);
-                }
-            }
-        }
-    }
-
-    fn object_hit(&self) -> Option<Collision> {
+    fn object_hit(&self, first: bool) -> Option<Collision> {
         let rule = self.object.as_ref()?;
         let name = |l: LinkId| self.model.links[l].name.clone();
-        let links = if self.checks == 1 {
-            &self.links
-        } else {
-            &self.moving
-        };
-        let strict: Vec<LinkId> = links
-            .iter()
-            .copied()
-            .filter(|l| !rule.touching.contains(l))
-            .collect();
+        let strict = &self.strict[usize::from(!first)];
         let hit = self
             .collision
-            .first_collision(&self.fk, &strict, &[rule.body], self.margin)
+            .placed_collision(&self.placement, strict, &[rule.body], self.margin)
             .map(|h| h.link)
             .or_else(|| {
                 self.collision
@@ -346,15 +335,12 @@ impl RobotWorld<'_> {
             }
         }
         // The carried object moves: every link but the hand's, every check.
-        let links: Vec<LinkId> = self
-            .links
-            .iter()
-            .copied()
-            .filter(|l| !at.holding.contains(l))
-            .collect();
-        let hit = self
-            .collision
-            .first_collision(&self.fk, &links, &[&at.body], self.margin)?;
+        let hit = self.collision.placed_collision(
+            &self.placement,
+            &self.carrying,
+            &[&at.body],
+            self.margin,
+        )?;
         Some(Collision {
             link: self.model.links[hit.link].name.clone(),
             with: carried,
@@ -368,28 +354,13 @@ impl Validity for RobotWorld<'_> {
     }
 }
 
-/// A sphere holding every part of `object` (from the parts' world AABBs).
-fn bounding_sphere(object: &CollisionObject) -> (Vector3<f64>, f64) {
-    let pose = tsukami_body::convert::to_pose(object.pose());
-    let mut lo = Vector3::repeat(f64::INFINITY);
-    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-    for part in object.parts() {
-        let aabb = part.shape.compute_aabb(&(pose * part.origin));
-        lo = lo.inf(&tsukami_body::convert::to_vector(aabb.mins));
-        hi = hi.sup(&tsukami_body::convert::to_vector(aabb.maxs));
-    }
-    if !lo.iter().chain(hi.iter()).all(|v| v.is_finite()) {
-        // No finite box (or no part): every link counts as near it.
-        return (Vector3::zeros(), f64::INFINITY);
-    }
-    ((lo + hi) / 2.0, (hi - lo).norm() / 2.0)
-}
-
-/// Per link: does a planned joint (or a mimic joint following one) move it?
-fn moved_links(model: &RobotModel, joints: &[JointId]) -> Vec<bool> {
-    let mut moved = vec![false; model.links.len()];
-    // Links are stored parents first: a link moves when its parent does or when
-    // its own joint is planned or mimics a planned joint.
+/// Per link: the last joint on its path from the root that a planned joint
+/// drives (the joint itself, or a mimic of it), if any. Links with the same
+/// value move as one rigid body: their relative pose never changes.
+fn moving_bodies(model: &RobotModel, joints: &[JointId]) -> Vec<Option<JointId>> {
+    let mut body = vec![None; model.links.len()];
+    // Links are stored parents first: a link moves with its parent unless its
+    // own joint is planned or mimics a planned joint.
     for l in 1..model.links.len() {
         let Some(j) = model.links[l].parent_joint else {
             continue;
@@ -400,9 +371,9 @@ fn moved_links(model: &RobotModel, joints: &[JointId]) -> Vec<bool> {
                 .mimic
                 .as_ref()
                 .is_some_and(|m| joints.contains(&m.master));
-        moved[l] = moved[joint.parent] || driven;
+        body[l] = if driven { Some(j) } else { body[joint.parent] };
     }
-    moved
+    body
 }
 
 /// The segment resolution of a [`RobotWorld`], as a value of its own so that a

@@ -104,7 +104,9 @@ pub enum RrtError {
     Cancelled,
 }
 
-/// Checks the straight segment `a → b`, excluding `a` itself (assumed checked).
+/// Checks the straight segment `a → b`, excluding `a` itself (assumed checked):
+/// every one of its `steps` points, coarse to fine ([`coarse_to_fine`]), so a
+/// blocked segment is usually found blocked after a few checks.
 pub fn segment_valid(
     validity: &mut impl Validity,
     steps: &impl SegmentSteps,
@@ -116,11 +118,31 @@ pub fn segment_valid(
         return false;
     }
     let mut q = vec![0.0; a.len()];
-    (1..=n).all(|i| {
+    coarse_to_fine(n).all(|i| {
         let t = i as f64 / n as f64;
         lerp_into(a, b, t, &mut q);
         validity.is_valid(&q)
     })
+}
+
+/// The indices `1..=n`, each once: `n` first, then bisection order — the
+/// midpoint, the quarter points, and so on (`i = odd · 2^k` for falling `k`).
+///
+/// ```
+/// use tsukami_trajectory_planner::rrt_connect::coarse_to_fine;
+/// assert_eq!(coarse_to_fine(6).collect::<Vec<_>>(), [6, 4, 2, 1, 3, 5]);
+/// let mut all: Vec<usize> = coarse_to_fine(1000).collect();
+/// all.sort();
+/// assert_eq!(all, (1..=1000).collect::<Vec<_>>());
+/// ```
+pub fn coarse_to_fine(n: usize) -> impl Iterator<Item = usize> {
+    let top = n
+        .checked_next_power_of_two()
+        .unwrap_or(1 << (usize::BITS - 1));
+    let strides = std::iter::successors(Some(top), |&s| (s > 1).then_some(s / 2));
+    std::iter::once(n)
+        .filter(|&n| n > 0)
+        .chain(strides.flat_map(move |s| (s..n).step_by(2 * s)))
 }
 
 /// `out = a + t (b − a)`.
