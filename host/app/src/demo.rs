@@ -8,7 +8,8 @@
 //!    head camera rendering the scene; its pose is compared with the scene file's;
 //! 2. **grasp**: SetRobot / SetObject / SetEnv / Plan with the scene file's object
 //!    pose (the truth, so the paper's outcomes are checked on the paper's scenes;
-//!    the vision error is reported beside them), judged against the paper;
+//!    the vision error is reported beside them) or, with `--plan-on vision`, the
+//!    pose the vision saw; judged against the paper on the scene file's object;
 //! 3. **motion**: `<ns>/motion/plan` from the controller's state (rest) to the
 //!    grasp and on to the lift;
 //! 4. **execution**: the controller runs it; the state it publishes at the end of
@@ -39,7 +40,7 @@ pub(crate) use table::{notes, plan_cells, step_cells};
 use crate::bus::{free_loopback_port, BusConfig};
 use crate::client::BusClient;
 use crate::config::{default_models_dir, HostConfig};
-use crate::scenes::{run_scene, SceneOutcome};
+use crate::scenes::{run_scene_at, SceneOutcome};
 use crate::server::RunningHost;
 use anyhow::{bail, Context, Result};
 use children::{locate, ComponentProcess, Supervisor};
@@ -49,7 +50,7 @@ use status::Status;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
-use step::Step;
+use step::{Step, StepStatus};
 use tsukami_msgs::host::PluginsReply;
 use tsukami_msgs::planner::ObjectShape;
 use tsukami_scenes::{scene_requests, PaperScene, PAPER_SCENES};
@@ -76,6 +77,11 @@ pub struct DemoArgs {
     /// How much faster than real time the controller executes (1 = real time).
     #[arg(long, default_value_t = 10.0)]
     pub speed: f64,
+    /// The object pose the grasp is planned on: the scene file's (`scene`), or
+    /// where the vision component saw it (`vision`; the scene file's when it did
+    /// not find it). Either way the grasp is judged on the scene file's object.
+    #[arg(long, value_enum, default_value_t = PlanOn::Scene)]
+    pub plan_on: PlanOn,
     /// Folder holding the component binaries (`tsukami-vision`,
     /// `tsukami-controller`). Default: the `tsukami` binary's own folder.
     #[arg(long)]
@@ -90,9 +96,20 @@ impl Default for DemoArgs {
             json: false,
             out: None,
             speed: 10.0,
+            plan_on: PlanOn::Scene,
             components_dir: None,
         }
     }
+}
+
+/// Which object pose a grasp is planned on.
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanOn {
+    /// The scene file's (the truth).
+    Scene,
+    /// The vision component's estimate.
+    Vision,
 }
 
 /// Where the report goes without `--out`.
@@ -111,6 +128,8 @@ pub struct DemoScene {
     /// The grasp, judged against the paper (`scene`, `expected`, `ok`, `result`, …).
     #[serde(flatten)]
     pub plan: SceneOutcome,
+    /// The object pose the grasp was planned on.
+    pub planned_on: PlanOn,
     /// The vision component's pose against the scene's.
     pub vision: Step<VisionCheck>,
     /// The trajectory planner's motion to the grasp and the lift.
@@ -278,9 +297,10 @@ impl Demo<'_> {
                 Err(why) => println!("  {name:<20} NOT RUN: {why}"),
             }
         }
-        println!(
-            "Grasps are planned on each scene file's object pose; the vision error is measured against it."
-        );
+        println!("{}", match self.args.plan_on {
+            PlanOn::Scene => "Grasps are planned on each scene file's object pose; the vision error is measured against it.",
+            PlanOn::Vision => "Grasps are planned where the vision saw the object (on the scene file's pose where it did not find it); judged on the scene file's.",
+        });
         println!("\n{}", table::header());
     }
 
@@ -338,17 +358,22 @@ impl Demo<'_> {
 
         let vision = self.vision(name, &file, &vision_process);
         drop(vision_process);
+        let seen = match (&vision.data, vision.status, self.args.plan_on) {
+            (Some(v), StepStatus::Ok, PlanOn::Vision) => Some(v.pose),
+            _ => None,
+        };
+        let planned_on = if seen.is_some() {
+            PlanOn::Vision
+        } else {
+            PlanOn::Scene
+        };
         self.status.step(name, "planning the grasp");
-        let plan = run_scene(
-            &self.client,
-            &self.models,
-            scene,
-            self.args.seed,
-            REQUEST_TIMEOUT,
-        );
+        let (seed, models) = (self.args.seed, &self.models);
+        let plan = run_scene_at(&self.client, models, scene, seed, REQUEST_TIMEOUT, seen);
         let (motion, execution) = self.motion(&plan, &controller);
         DemoScene {
             plan,
+            planned_on,
             vision,
             motion,
             execution,

@@ -11,7 +11,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER};
 use tsukami_msgs::planner::{ObjectSummary, PlanOptions, PlanReply, WholeBody};
-use tsukami_msgs::ErrorCode;
+use tsukami_msgs::{ErrorCode, Pose};
 use tsukami_scenes::{scene_requests, verify, PaperScene, Tolerances, World};
 
 /// The `details.reason` of the planner's error when no palm pose is reachable.
@@ -95,6 +95,20 @@ pub fn run_scene(
     seed: u64,
     timeout: Duration,
 ) -> SceneOutcome {
+    run_scene_at(client, models_dir, scene, seed, timeout, None)
+}
+
+/// [`run_scene`], with the object at `object_pose` (e.g. where the vision saw it)
+/// instead of the scene file's pose. The reply is still judged in the scene
+/// file's world: the grasp must hold the object where it really is.
+pub fn run_scene_at(
+    client: &BusClient,
+    models_dir: &Path,
+    scene: &PaperScene,
+    seed: u64,
+    timeout: Duration,
+    object_pose: Option<Pose>,
+) -> SceneOutcome {
     let mut outcome = SceneOutcome {
         scene: scene.name.to_owned(),
         expected: scene.expected.to_owned(),
@@ -106,20 +120,37 @@ pub fn run_scene(
         plan_ms: 0.0,
         weight_scale: None,
     };
-    if let Err(problem) = plan_scene(client, models_dir, scene, seed, timeout, &mut outcome) {
+    let setup = Setup {
+        seed,
+        timeout,
+        object_pose,
+    };
+    if let Err(problem) = plan_scene(client, models_dir, scene, &setup, &mut outcome) {
         outcome.problem = Some(problem);
     }
     outcome
+}
+
+/// How a scene is planned.
+struct Setup {
+    seed: u64,
+    timeout: Duration,
+    /// The object's pose sent to the planner, when not the scene file's.
+    object_pose: Option<Pose>,
 }
 
 fn plan_scene(
     client: &BusClient,
     models_dir: &Path,
     scene: &PaperScene,
-    seed: u64,
-    timeout: Duration,
+    setup: &Setup,
     outcome: &mut SceneOutcome,
 ) -> Result<(), String> {
+    let Setup {
+        seed,
+        timeout,
+        object_pose,
+    } = *setup;
     let file = models_dir
         .join("scenes")
         .join(format!("{}.toml", scene.name));
@@ -127,13 +158,13 @@ fn plan_scene(
     let world = World::from_requests(models_dir, &requests.robot, &requests.object, &requests.env)
         .map_err(|e| format!("the checker's world: {e}"))?;
     send(client, planner::SET_ROBOT, &requests.robot, timeout)?;
-    let object: ObjectSummary = serde_json::from_slice(&send(
-        client,
-        planner::SET_OBJECT,
-        &requests.object,
-        timeout,
-    )?)
-    .map_err(|e| format!("set_object reply: {e}"))?;
+    let mut set_object = requests.object.clone();
+    if let Some(pose) = object_pose {
+        set_object.pose = pose;
+    }
+    let object: ObjectSummary =
+        serde_json::from_slice(&send(client, planner::SET_OBJECT, &set_object, timeout)?)
+            .map_err(|e| format!("set_object reply: {e}"))?;
     outcome.regions = object.regions.len();
     send(client, planner::SET_ENV, &requests.env, timeout)?;
 
