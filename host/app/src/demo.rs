@@ -52,6 +52,7 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use step::{Step, StepStatus};
 use tsukami_msgs::host::PluginsReply;
+use tsukami_msgs::keys::ROLE_TRAJECTORY_PLANNER;
 use tsukami_msgs::planner::ObjectShape;
 use tsukami_scenes::{scene_requests, PaperScene, PAPER_SCENES};
 use vision::VisionCheck;
@@ -118,6 +119,9 @@ pub const DEFAULT_REPORT_DIR: &str = "target/demo-report";
 /// Timeout of every request but `execute` (whose own is the motion's duration
 /// plus a margin).
 const REQUEST_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// How long the trajectory planner waits for the controller's state.
+const CONTROLLER_STATE_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// How long a component may take to answer on the bus after it was started.
 const COMPONENT_READY: Duration = Duration::from_secs(60);
@@ -244,6 +248,15 @@ fn selected(args: &DemoArgs) -> Result<Vec<&'static PaperScene>> {
 fn start_host() -> Result<(RunningHost, HostConfig)> {
     let port = free_loopback_port()?;
     let mut config = HostConfig::default_config()?;
+    // The motion starts from the controller's state: give a loaded machine time
+    // to answer (the plugin's default, 200 ms, falls back to rest after it).
+    for entry in &mut config.plugins {
+        if entry.role == ROLE_TRAJECTORY_PLANNER {
+            let table = entry.config.get_or_insert_with(toml::Table::new);
+            let ms = CONTROLLER_STATE_TIMEOUT.as_millis() as i64;
+            table.insert("controller_timeout_ms".into(), ms.into());
+        }
+    }
     config.namespace = format!("tsukami-demo-{port}");
     config.bus = BusConfig::listening(&format!("tcp/127.0.0.1:{port}"));
     let host = RunningHost::start(&config)?;
