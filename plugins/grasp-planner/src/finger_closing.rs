@@ -12,15 +12,11 @@
 //! contact link: a middle phalanx that meets the object before the fingertip
 //! stops the finger there (and is the contact), it never sinks in.
 //!
-//! How: the assigned joint moves toward its upper limit; after each step the
-//! nearest of the links it moves ([`moved_links`]: the joint's subtree and the
-//! subtrees of joints mimicking it) is measured, and the next step is that
-//! distance over the links' speed bound ([`closing_speed`]: conservative
-//! advancement, long strides when far, short ones near the surface, never
-//! through it). When the distance falls under the threshold the finger is
-//! touching; a link that still overshoots into the object (only with the
-//! fixed step, for a finger without a finite bound) bisects the last step so
-//! the finger ends just touching. A
+//! How: the assigned joint moves toward its upper limit by the closing step;
+//! after each step the nearest of the links it moves ([`moved_links`]: the
+//! joint's subtree and the subtrees of joints mimicking it) is measured; when
+//! that distance falls under the threshold (or a link overshoots into the
+//! object) the last step is bisected so the finger ends just touching. A
 //! finger that reaches its joint limit without touching, or starts inside the
 //! object, fails the whole closing. The force limit is `min_j τ_max,j / |Jᵀn|`
 //! over the finger's joints, capped by the description's `max_finger_force`
@@ -33,7 +29,6 @@ use tsukami_body::kinematics::FkState;
 use tsukami_body::model::{JointId, LinkId, RobotModel};
 use tsukami_planner_kit::blocks::force::finger_force;
 
-use crate::closing_speed::closing_speed;
 use crate::hand::{HandModel, ResolvedContact};
 
 /// One finger contact, world frame.
@@ -116,17 +111,6 @@ fn distance_at(
         .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance))
 }
 
-/// The next joint step from distance `d`: conservative advancement, `d / R`
-/// with `R` the [`closing_speed`] bound, cannot reach the object; the grasp
-/// type's fixed `step` serves only when no finite bound exists.
-fn advance(d: f64, speed: f64, step: f64) -> f64 {
-    if speed.is_finite() && speed > 0.0 {
-        d / speed
-    } else {
-        step
-    }
-}
-
 fn close_one(
     hand: &HandModel,
     c: &ResolvedContact,
@@ -147,13 +131,12 @@ fn close_one(
     let mut angle = prev;
     // At most one turn, even for a joint without an upper limit.
     let upper = upper.min(prev + std::f64::consts::TAU);
-    let speed = closing_speed(&hand.robot, &hand.collision, c.joint);
     while near.1.distance >= threshold {
         if angle >= upper {
             return None; // closed fully without touching
         }
         prev = angle;
-        angle = (angle + advance(near.1.distance, speed, step)).min(upper);
+        angle = (angle + step).min(upper);
         near = distance_at(hand, c, &links, q, fk, object, angle)?;
     }
     // Overshot into the object: bisect the last step.

@@ -31,7 +31,6 @@
 //! assert_eq!(grasp.grasp_type.name, "fingertip4_mid");
 //! ```
 
-pub mod closing_speed;
 pub mod finger_closing;
 pub mod grasp_type;
 pub mod hand;
