@@ -197,6 +197,12 @@ library = "tsukami_grasp_planner"
 [[plugin]]
 role = "trajectory-planner"
 library = "tsukami_trajectory_planner"
+
+[[plugin]]
+role = "result-viewer"
+library = "tsukami_result_viewer"
+[plugin.config]
+web = "127.0.0.1:17448"     # the live view: http://127.0.0.1:17448/ (a free port if taken; the log says)
 "#;
 
 impl HostConfig {

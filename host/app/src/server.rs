@@ -61,6 +61,26 @@ struct Worker {
     world: Option<Arc<WorldHub>>,
 }
 
+/// Where a role's answers are published after they are sent (`<ns>/<prefix>/result/<command>`,
+/// the reply's JSON or `{"error": …}`), so the result viewer follows plans it did not
+/// ask for. zenoh's default for a put drops rather than waits on congestion: never
+/// delays the worker.
+struct ResultOut {
+    session: zenoh::Session,
+    keys: KeySpace,
+    role: String,
+}
+
+impl ResultOut {
+    fn publish(&self, command: &str, bytes: Vec<u8>) {
+        let key = self.keys.command(&self.role, &format!("result/{command}"));
+        let put = self.session.put(&key, bytes);
+        if let Err(e) = put.encoding(Encoding::APPLICATION_JSON).wait() {
+            tracing::debug!("result not published on {key}: {e}");
+        }
+    }
+}
+
 /// How often the watchdog looks at the running call.
 const WATCHDOG_TICK: Duration = Duration::from_millis(10);
 
@@ -209,6 +229,7 @@ fn worker_loop(
     jobs: Arc<Mutex<mpsc::Receiver<Job>>>,
     current: Arc<Mutex<CurrentCall>>,
     max_call: Duration,
+    results: Option<Arc<ResultOut>>,
 ) {
     // Workers of one plugin share its queue; each takes the next job.
     let next = || jobs.lock().unwrap_or_else(|p| p.into_inner()).recv();
@@ -228,8 +249,16 @@ fn worker_loop(
             slot.started = None;
             slot.timed_out
         };
+        let publish = |bytes: Vec<u8>| {
+            if let Some(out) = &results {
+                out.publish(&job.command, bytes);
+            }
+        };
         match result {
-            Ok(bytes) => reply_json(&job.query, bytes),
+            Ok(bytes) => {
+                reply_json(&job.query, bytes.clone());
+                publish(bytes);
+            }
             Err(err) => {
                 if err.code == tsukami_plugin_api::CallError::PANICKED {
                     tracing::error!(plugin = name.as_str(), "{}", err.message);
@@ -255,7 +284,9 @@ fn worker_loop(
                         "max_call_ms": max_call.as_millis() as u64,
                     }));
                 }
+                let bytes = reply.to_json_bytes();
                 reply_error(&job.query, reply);
+                publish(bytes);
             }
         }
     }
@@ -381,11 +412,20 @@ impl RunningHost {
             let (queue, jobs) = mpsc::sync_channel(limits.max_queue);
             let jobs = Arc::new(Mutex::new(jobs));
             let n_workers = crate::world::workers_for(entry, &info);
+            // The viewer's own replies (pictures) are not results to follow.
+            let results = (entry.role != keys::ROLE_RESULT_VIEWER).then(|| {
+                Arc::new(ResultOut {
+                    session: session.clone(),
+                    keys: keys.clone(),
+                    role: entry.role.clone(),
+                })
+            });
             let mut slots = Vec::new();
             for k in 0..n_workers {
                 let current = Arc::new(Mutex::new(CurrentCall::default()));
                 slots.push(current.clone());
                 let (name, jobs, plugin) = (info.name.clone(), jobs.clone(), instance.clone());
+                let results = results.clone();
                 let watched = Arc::downgrade(&current);
                 std::thread::Builder::new()
                     .name(format!("watchdog-{}-{k}", entry.role))
@@ -394,7 +434,9 @@ impl RunningHost {
                 host.workers.push(
                     std::thread::Builder::new()
                         .name(format!("plugin-{}-{k}", entry.role))
-                        .spawn(move || worker_loop(plugin, name, jobs, current, limits.max_call))
+                        .spawn(move || {
+                            worker_loop(plugin, name, jobs, current, limits.max_call, results)
+                        })
                         .context("spawning a plugin worker thread")?,
                 );
             }

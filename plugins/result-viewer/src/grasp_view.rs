@@ -129,3 +129,31 @@ pub fn contact_marks(reply: &PlanReply) -> Vec<ContactMark> {
         })
         .collect()
 }
+
+/// What a grasp picture looks at: midway between the centre of the object's
+/// box (at `pose`) and the contacts' centroid; the box centre without
+/// contacts; the object's origin if the mesh has no finite box.
+pub fn look_at(
+    mesh: &TriangleMesh,
+    pose: &Isometry3<f64>,
+    contacts: &[ContactMark],
+) -> Point3<f64> {
+    let (lo, hi) = mesh.vertices.iter().fold(
+        (
+            Point3::from([f64::INFINITY; 3]),
+            Point3::from([f64::NEG_INFINITY; 3]),
+        ),
+        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+    );
+    let center = pose * nalgebra::center(&lo, &hi);
+    if !center.coords.iter().all(|c| c.is_finite()) {
+        return Point3::from(pose.translation.vector);
+    }
+    if contacts.is_empty() {
+        return center;
+    }
+    let sum = contacts
+        .iter()
+        .fold(Vector3::zeros(), |s, c| s + c.position.coords);
+    Point3::from((center.coords + sum / contacts.len() as f64) / 2.0)
+}

@@ -16,6 +16,10 @@
 //! [`render::Camera`] into a depth buffer with Lambert shading; the glTF
 //! writer puts one mesh and one node per group into a single binary buffer.
 //!
+//! As the `result-viewer` plugin ([`plugin`]) it shares the host's world,
+//! follows plan and motion results on the bus ([`follow`]) and serves a live
+//! three.js view of them on loopback ([`web`]).
+//!
 //! ```
 //! use nalgebra::{Point3, Vector3};
 //! use tsukami_result_viewer::drawing::{Drawing, Rgba};
@@ -29,6 +33,13 @@
 //! ```
 
 pub mod drawing;
+pub mod follow;
 pub mod glb;
 pub mod grasp_view;
+pub mod latest;
+pub mod plugin;
 pub mod render;
+pub mod scene;
+pub mod viewer;
+pub mod web;
+pub mod world;

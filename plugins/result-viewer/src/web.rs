@@ -1,0 +1,281 @@
+//! The live web view: a small HTTP server on loopback for the page, its
+//! scripts and the viewer's JSON, with server-sent events for live updates.
+//!
+//! What: [`WebServer::start`] binds the configured address (127.0.0.1 unless
+//! configured otherwise; with `fallback`, a free port when that one is taken)
+//! and serves `GET /` (the page), `/viewer.js`, `/three/*` (three.js, vendored
+//! with its licence: the page works offline), `/scene.json`, `/state.json`,
+//! `/trajectory.json` and `/events` (an event stream: the state JSON on every
+//! change, at most [`MIN_EVENT_INTERVAL`] apart).
+//!
+//! Why: a person judges a grasp by looking at it, also on a headless robot PC
+//! reached through an SSH tunnel; no GPU or display is needed on the server.
+//!
+//! How: `std::net` with a thread per connection, at most `max_clients` at
+//! once (more get 503). Reads and writes time out, so a slow or vanished
+//! browser ends only its own thread; nothing here ever holds a lock the bus
+//! followers or the plugin's calls wait on while writing. A request whose
+//! `Host` is not a loopback name is refused when bound to loopback (DNS
+//! rebinding).
+
+use std::io::{self, Read, Write};
+use std::net::{SocketAddr, TcpListener, TcpStream};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use crate::viewer::Viewer;
+
+/// Socket read and write timeout.
+const IO_TIMEOUT: Duration = Duration::from_secs(5);
+/// Largest request head read.
+const MAX_HEAD: usize = 8192;
+/// Shortest time between two events to one page.
+pub const MIN_EVENT_INTERVAL: Duration = Duration::from_millis(100);
+/// A comment is sent on a quiet event stream this often (finds closed pages).
+const KEEPALIVE: Duration = Duration::from_secs(10);
+
+const INDEX: &[u8] = include_bytes!("../assets/index.html");
+const SCRIPT: &[u8] = include_bytes!("../assets/viewer.js");
+const THREE_MODULE: &[u8] = include_bytes!("../assets/three/three.module.js");
+const THREE_CORE: &[u8] = include_bytes!("../assets/three/three.core.js");
+const ORBIT: &[u8] = include_bytes!("../assets/three/OrbitControls.js");
+const THREE_LICENSE: &[u8] = include_bytes!("../assets/three/LICENSE");
+
+/// The running server; dropping it stops accepting (open streams end at
+/// their next write or when the viewer's board closes).
+pub struct WebServer {
+    addr: SocketAddr,
+    stop: Arc<AtomicBool>,
+    accept: Option<JoinHandle<()>>,
+}
+
+/// Binds `addr`, or with `fallback` a free port on the same address when
+/// `addr`'s port is taken.
+fn bind(addr: SocketAddr, fallback: bool) -> io::Result<TcpListener> {
+    match TcpListener::bind(addr) {
+        Err(e) if fallback && e.kind() == io::ErrorKind::AddrInUse => {
+            TcpListener::bind(SocketAddr::new(addr.ip(), 0))
+        }
+        other => other,
+    }
+}
+
+impl WebServer {
+    /// Starts serving `viewer` on `addr` (see [`bind`] for `fallback`).
+    pub fn start(
+        addr: SocketAddr,
+        fallback: bool,
+        max_clients: usize,
+        viewer: Arc<Viewer>,
+    ) -> io::Result<WebServer> {
+        let listener = bind(addr, fallback)?;
+        let addr = listener.local_addr()?;
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = stop.clone();
+        let active = Arc::new(AtomicUsize::new(0));
+        let accept = std::thread::Builder::new()
+            .name("viewer-web".into())
+            .spawn(move || {
+                for stream in listener.incoming() {
+                    if flag.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    let Ok(stream) = stream else { continue };
+                    connection(stream, &viewer, &active, max_clients, addr, &flag);
+                }
+            })?;
+        Ok(WebServer {
+            addr,
+            stop,
+            accept: Some(accept),
+        })
+    }
+
+    /// Where it serves.
+    pub fn addr(&self) -> SocketAddr {
+        self.addr
+    }
+
+    /// The page's address.
+    pub fn url(&self) -> String {
+        format!("http://{}/", self.addr)
+    }
+}
+
+impl Drop for WebServer {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        // Wake the accept loop.
+        let _ = TcpStream::connect_timeout(&self.addr, Duration::from_secs(1));
+        if let Some(t) = self.accept.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// Counts a connection while it lives.
+struct Slot(Arc<AtomicUsize>);
+
+impl Drop for Slot {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::Relaxed);
+    }
+}
+
+/// Hands `stream` to a thread of its own, or answers 503 when full.
+fn connection(
+    mut stream: TcpStream,
+    viewer: &Arc<Viewer>,
+    active: &Arc<AtomicUsize>,
+    max_clients: usize,
+    bound: SocketAddr,
+    stop: &Arc<AtomicBool>,
+) {
+    let _ = stream.set_read_timeout(Some(IO_TIMEOUT));
+    let _ = stream.set_write_timeout(Some(IO_TIMEOUT));
+    if active.fetch_add(1, Ordering::Relaxed) >= max_clients {
+        active.fetch_sub(1, Ordering::Relaxed);
+        let _ = respond(
+            &mut stream,
+            "503 Service Unavailable",
+            "text/plain",
+            b"too many connections\n",
+        );
+        return;
+    }
+    let slot = Slot(active.clone());
+    let (viewer, stop) = (viewer.clone(), stop.clone());
+    let spawned = std::thread::Builder::new()
+        .name("viewer-web-conn".into())
+        .spawn(move || {
+            let _slot = slot;
+            let _ = serve(stream, &viewer, bound, &stop);
+        });
+    drop(spawned);
+}
+
+/// Reads the request head (up to the blank line).
+fn read_head(stream: &mut TcpStream) -> io::Result<String> {
+    let mut head = Vec::with_capacity(1024);
+    let mut buf = [0u8; 1024];
+    while !head.windows(4).any(|w| w == b"\r\n\r\n") {
+        if head.len() > MAX_HEAD {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                "request head too large",
+            ));
+        }
+        let n = stream.read(&mut buf)?;
+        if n == 0 {
+            return Err(io::ErrorKind::UnexpectedEof.into());
+        }
+        head.extend_from_slice(&buf[..n]);
+    }
+    Ok(String::from_utf8_lossy(&head).into_owned())
+}
+
+/// Writes a whole response and closes.
+fn respond(stream: &mut TcpStream, status: &str, kind: &str, body: &[u8]) -> io::Result<()> {
+    let head = format!(
+        "HTTP/1.1 {status}\r\nContent-Type: {kind}\r\nContent-Length: {}\r\nCache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
+        body.len()
+    );
+    stream.write_all(head.as_bytes())?;
+    stream.write_all(body)?;
+    stream.flush()
+}
+
+/// True when the request's `Host` names the loopback interface.
+fn loopback_host(head: &str) -> bool {
+    head.lines()
+        .filter_map(|l| l.split_once(':'))
+        .find(|(name, _)| name.trim().eq_ignore_ascii_case("host"))
+        .is_some_and(|(_, value)| {
+            let v = value.trim();
+            let host = v.rsplit_once(':').map_or(v, |(h, _)| h);
+            matches!(host, "127.0.0.1" | "localhost" | "[::1]")
+        })
+}
+
+/// Answers one request.
+fn serve(
+    mut stream: TcpStream,
+    viewer: &Viewer,
+    bound: SocketAddr,
+    stop: &AtomicBool,
+) -> io::Result<()> {
+    let head = read_head(&mut stream)?;
+    let mut words = head.split_whitespace();
+    let (method, target) = (words.next().unwrap_or(""), words.next().unwrap_or(""));
+    if method != "GET" {
+        return respond(
+            &mut stream,
+            "405 Method Not Allowed",
+            "text/plain",
+            b"GET only\n",
+        );
+    }
+    if bound.ip().is_loopback() && !loopback_host(&head) {
+        return respond(
+            &mut stream,
+            "403 Forbidden",
+            "text/plain",
+            b"Host must be a loopback name\n",
+        );
+    }
+    const JS: &str = "text/javascript; charset=utf-8";
+    const JSON: &str = "application/json";
+    let path = target.split('?').next().unwrap_or("");
+    match path {
+        "/" | "/index.html" => respond(&mut stream, "200 OK", "text/html; charset=utf-8", INDEX),
+        "/viewer.js" => respond(&mut stream, "200 OK", JS, SCRIPT),
+        "/three/three.module.js" => respond(&mut stream, "200 OK", JS, THREE_MODULE),
+        "/three/three.core.js" => respond(&mut stream, "200 OK", JS, THREE_CORE),
+        "/three/OrbitControls.js" => respond(&mut stream, "200 OK", JS, ORBIT),
+        "/three/LICENSE" => respond(
+            &mut stream,
+            "200 OK",
+            "text/plain; charset=utf-8",
+            THREE_LICENSE,
+        ),
+        "/scene.json" => respond(&mut stream, "200 OK", JSON, &viewer.scene_json()),
+        "/state.json" => respond(&mut stream, "200 OK", JSON, &viewer.state_json()),
+        "/trajectory.json" => respond(&mut stream, "200 OK", JSON, &viewer.trajectory_json()),
+        "/events" => events(stream, viewer, stop),
+        _ => respond(&mut stream, "404 Not Found", "text/plain", b"not found\n"),
+    }
+}
+
+/// The event stream: the state now, then on every change (rate-limited) and
+/// a keep-alive comment when quiet; ends on a failed write or on close.
+fn events(mut stream: TcpStream, viewer: &Viewer, stop: &AtomicBool) -> io::Result<()> {
+    stream.write_all(
+        b"HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-cache\r\nConnection: keep-alive\r\n\r\n",
+    )?;
+    viewer.event_clients.fetch_add(1, Ordering::Relaxed);
+    let result = (|| loop {
+        let seen = viewer.board.generation();
+        let state = viewer.state_json();
+        stream.write_all(b"event: state\ndata: ")?;
+        stream.write_all(&state)?;
+        stream.write_all(b"\n\n")?;
+        stream.flush()?;
+        viewer.sent();
+        let sent_at = Instant::now();
+        loop {
+            if stop.load(Ordering::Relaxed) || viewer.board.is_closed() {
+                return Ok(());
+            }
+            if viewer.board.wait_past(seen, KEEPALIVE).is_some() {
+                break;
+            }
+            stream.write_all(b": keep-alive\n\n")?;
+            stream.flush()?;
+        }
+        std::thread::sleep(MIN_EVENT_INTERVAL.saturating_sub(sent_at.elapsed()));
+    })();
+    viewer.event_clients.fetch_sub(1, Ordering::Relaxed);
+    result
+}
