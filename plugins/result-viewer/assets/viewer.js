@@ -33,7 +33,8 @@ const bodies = new THREE.Group();   // links, object, obstacles
 const marks = new THREE.Group();    // contacts and friction cones
 scene.add(bodies, marks);
 let links = [];                     // one THREE.Group per robot link
-let framed = false;
+let object = null;                  // the object's THREE.Group
+let framed = null;                  // the object the camera was aimed at
 let state = null;
 let trajectory = null;
 
@@ -70,6 +71,7 @@ function clear(group) {
 async function loadScene() {
   const geometry = await (await fetch('/scene.json', { cache: 'no-store' })).json();
   clear(bodies);
+  object = null;
   links = geometry.links.map((link) => {
     const g = new THREE.Group();
     g.name = link.name;
@@ -82,11 +84,15 @@ async function loadScene() {
     for (const s of geometry.object.solids) g.add(mesh(s));
     place(g, geometry.object.pose);
     bodies.add(g);
-    if (!framed) {
+    object = g;
+    // A new object (or a moved one) is looked at afresh; the same one keeps
+    // the view the user orbited to.
+    const key = `${geometry.object.name} ${geometry.object.pose.map((x) => x.toFixed(3))}`;
+    if (framed !== key) {
       const p = geometry.object.pose;
       controls.target.set(p[0], p[1], p[2]);
       camera.position.set(p[0] + 0.45, p[1] - 1.0, p[2] + 0.45);
-      framed = true;
+      framed = key;
     }
   }
   for (const s of geometry.obstacles) bodies.add(mesh(s));
@@ -192,6 +198,15 @@ async function apply(s) {
     document.getElementById('info').innerHTML = `<span class="error">${esc(e)}</span>`;
   }
 }
+
+// Where a body's box centre is on the page (CSS pixels from the top left):
+// `object` or a link name; null when absent. Lets a test look there.
+view.screen = (name) => {
+  const o = name === 'object' ? object : links.find((l) => l.name === name);
+  if (!o) return null;
+  const c = new THREE.Box3().setFromObject(o).getCenter(new THREE.Vector3()).project(camera);
+  return [(c.x + 1) / 2 * window.innerWidth, (1 - c.y) / 2 * window.innerHeight];
+};
 
 const events = new EventSource('/events');
 events.addEventListener('state', (e) => {
