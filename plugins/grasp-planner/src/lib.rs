@@ -31,9 +31,11 @@
 //! assert_eq!(grasp.grasp_type.name, "fingertip4_mid");
 //! ```
 
+pub mod clearance;
 pub mod finger_closing;
 pub mod grasp_type;
 pub mod hand;
+pub mod link_sets;
 pub mod object;
 pub mod ocp;
 pub mod palm_pose;

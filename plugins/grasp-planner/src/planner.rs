@@ -35,13 +35,16 @@
 use std::time::{Duration, Instant};
 
 use nalgebra::Isometry3;
+use tsukami_body::collision::CollisionObject;
 use tsukami_body::ik::{IkOptions, IkSolver};
-use tsukami_body::kinematics::JointSelection;
+use tsukami_body::kinematics::{FkState, JointSelection};
 use tsukami_msgs::planner::{FaceBlock, OcpBox, PlanOptions, PlanPhase};
 use tsukami_planner_kit::{FingerContact, Grasp, GraspPlanner, KitError, NoGrasp, Stop};
 use tsukami_planner_kit::{Object, PlannerConfig, PlannerInfo, Robot, Run, World};
 
+use crate::clearance::{clear_nominal, max_lift, Surroundings};
 use crate::hand::HandModel;
+use crate::link_sets::LinkSets;
 use crate::object::PlanObject;
 use crate::ocp::OcpParams;
 use crate::palm_pose::{criterion_value, palm_targets};
@@ -91,6 +94,9 @@ struct Nominal {
     palm: Isometry3<f64>,
     q: Vec<f64>,
     cost: f64,
+    /// The open hand at the nominal pose already touches an obstacle, the
+    /// robot itself or the object where it may not (searched after the rest).
+    blocked: bool,
 }
 
 impl GraspPlanner for Paper {
@@ -191,14 +197,15 @@ impl GraspPlanner for Paper {
                 &selection.candidates,
                 &stage,
                 opts,
-                (si, floor),
+                (si, floor, &w.obstacles),
                 run,
             )?;
             if nominals.is_empty() {
                 continue;
             }
             any_reachable = true;
-            nominals.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+            // Approaches the support or an obstacle blocks go last; then by cost.
+            nominals.sort_by(|a, b| a.blocked.cmp(&b.blocked).then(a.cost.total_cmp(&b.cost)));
             for (k, nom) in nominals
                 .iter()
                 .take(opts.max_candidates.max(1) as usize)
@@ -304,9 +311,10 @@ impl Paper {
         candidates: &[Candidate],
         stage: &StageJoints,
         opts: &PlanOptions,
-        (si, floor): (usize, Option<f64>),
+        (si, floor, env): (usize, Option<f64>, &[&CollisionObject]),
         run: &mut Run,
     ) -> Result<Vec<Nominal>, NoGrasp> {
+        let mut fk = FkState::new(&hand.robot);
         let mut q_init = hand.robot.rest_positions();
         // A natural start: elbow bent (seeds the IK away from the straight-arm singularity).
         if let Some(&elbow) = hand.arm.get(3) {
@@ -327,23 +335,38 @@ impl Paper {
         let Ok(mut ik) = IkSolver::new(&hand.robot, hand.palm, sel, ik_opts) else {
             return Ok(out);
         };
+        let around = Surroundings {
+            object: &object.collision,
+            env,
+        };
         for cand in candidates {
             let g = &hand.config.grasp_types[cand.grasp_type];
-            for target in palm_targets(g, &object.ocps[cand.region], cand.face, floor) {
+            let links = LinkSets::for_type(hand, cand.grasp_type, &stage.extra);
+            let ocp = &object.ocps[cand.region];
+            for target in palm_targets(g, ocp, cand.face, floor) {
                 run.check()?;
                 let mut q0 = q_init.clone();
                 hand.set_posture(cand.grasp_type, &mut q0);
-                let sol = ik.solve(&target.palm, true, &q0, Some(&q_init));
-                if !sol.ok {
+                let Some(c) = clear_nominal(
+                    &mut ik,
+                    hand,
+                    &links,
+                    &target.palm,
+                    (&q0, &q_init),
+                    &around,
+                    max_lift(ocp),
+                    &mut fk,
+                ) else {
                     continue;
-                }
-                let cost = criterion_value(hand, &sol.q, opts.palm_criterion, &stage.joints)
+                };
+                let cost = criterion_value(hand, &c.q, opts.palm_criterion, &stage.joints)
                     + self.params.score_weight * cand.score;
                 out.push(Nominal {
                     candidate: cand.clone(),
-                    palm: target.palm,
-                    q: sol.q,
+                    palm: c.palm,
+                    q: c.q,
                     cost,
+                    blocked: c.blocked,
                 });
             }
         }

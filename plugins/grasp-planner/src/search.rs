@@ -33,7 +33,6 @@ use rand_chacha::ChaCha8Rng;
 use tsukami_body::collision::CollisionObject;
 use tsukami_body::ik::{IkOptions, IkSolver};
 use tsukami_body::kinematics::{FkState, JointSelection};
-use tsukami_body::model::LinkId;
 use tsukami_grasp::contact::Contact;
 use tsukami_grasp::ellipsoid::{ellipsoid_test, EllipsoidModel};
 use tsukami_grasp::exact::{exact_test, ConeModel};
@@ -41,8 +40,9 @@ use tsukami_grasp::grasp::Grasp;
 
 use crate::finger_closing::{close_fingers, FingerContact};
 use crate::hand::HandModel;
+use crate::link_sets::LinkSets;
 use crate::object::PlanObject;
-use crate::verify::{check_grasp, PENETRATION_TOLERANCE};
+use crate::verify::check_grasp;
 use crate::whole_body::{Stage, StageJoints};
 
 /// Gravity (world frame, m/s²).
@@ -218,16 +218,7 @@ pub fn search(
     let g = &hand.config.grasp_types[t];
     let approach = g.approach();
     let spec = &hand.types[t];
-    let contact_links: Vec<LinkId> = spec.contacts.iter().map(|c| c.link).collect();
-    let allowed: Vec<LinkId> = hand
-        .config
-        .hand
-        .touch_allowed
-        .iter()
-        .chain(g.touch_allowed.iter())
-        .filter_map(|n| robot.link_id(n).ok())
-        .collect();
-    let links = LinkSets::new(hand, &contact_links, &allowed, &stage.extra);
+    let links = LinkSets::for_type(hand, t, &stage.extra);
     let object = &ctx.object.collision;
     let mut fk = FkState::new(robot);
     let mut q = q_nominal.to_vec();
@@ -343,92 +334,6 @@ pub fn search(
         }));
     }
     Outcome::Exhausted
-}
-
-/// The robot's links with geometry, split by what they may do to the object.
-struct LinkSets {
-    /// Every link the stage moves — arm and hand, and the torso, head and
-    /// other arm when waist or squat joints move them: none may touch an
-    /// obstacle.
-    moving: Vec<LinkId>,
-    /// Contact and `touch_allowed` links: may touch the object, sink in at
-    /// most half the verification tolerance.
-    touching: Vec<LinkId>,
-    /// The rest: may not touch the object.
-    not_touching: Vec<LinkId>,
-}
-
-impl LinkSets {
-    fn new(
-        hand: &HandModel,
-        contact_links: &[LinkId],
-        allowed: &[LinkId],
-        extra_joints: &[tsukami_body::JointId],
-    ) -> Self {
-        let robot = &hand.robot;
-        // Links below a waist or squat joint move with it.
-        let mut below: Vec<LinkId> = extra_joints
-            .iter()
-            .map(|&j| robot.joints[j].child)
-            .collect();
-        let mut k = 0;
-        while k < below.len() {
-            below.extend(robot.links[below[k]].children.iter().copied());
-            k += 1;
-        }
-        let moving: Vec<LinkId> = hand
-            .arm_links
-            .iter()
-            .chain(hand.hand_links.iter())
-            .chain(hand.body_links.iter().filter(|l| below.contains(l)))
-            .copied()
-            .filter(|&l| !hand.collision.link_parts(l).is_empty())
-            .fold(Vec::new(), |mut v, l| {
-                if !v.contains(&l) {
-                    v.push(l);
-                }
-                v
-            });
-        let (touching, not_touching) = moving
-            .iter()
-            .partition(|l| contact_links.contains(l) || allowed.contains(l));
-        Self {
-            moving,
-            touching,
-            not_touching,
-        }
-    }
-
-    /// What blocks the posture in `fk`, as `"<link> vs <what>"`: a link
-    /// touching an obstacle, a link that may not touch the object touching
-    /// it, a touching link sinking into it, or (`self_check`) two links.
-    fn blocked(
-        &self,
-        hand: &HandModel,
-        fk: &FkState,
-        object: &CollisionObject,
-        env: &[&CollisionObject],
-        self_check: bool,
-    ) -> Option<String> {
-        let c = &hand.collision;
-        let name = |l: LinkId| hand.robot.links[l].name.as_str();
-        if let Some(h) = c.first_collision(fk, &self.moving, env, 0.0) {
-            return Some(format!("{} vs {}", name(h.link), env[h.object].name));
-        }
-        if let Some(h) = c.first_collision(fk, &self.not_touching, &[object], 0.0) {
-            return Some(format!("{} vs the object", name(h.link)));
-        }
-        let tol = 0.5 * PENETRATION_TOLERANCE;
-        if let Some(p) = c.first_penetration(fk, &self.touching, &[object], tol) {
-            return Some(format!("{} into the object", name(p.link)));
-        }
-        if self_check {
-            if let Some((a, b)) = c.first_self_collision(fk, 0.0) {
-                return Some(format!("{} vs {}", name(a), name(b)));
-            }
-        }
-        None
-    }
 }
 
 /// The grasp of `contacts` on `object` (torques about the centre of mass).

@@ -1,0 +1,127 @@
+//! Turning a nominal palm pose away from the support: lift it until the open
+//! hand clears the obstacles.
+//!
+//! What: [`clear_nominal`] solves the IK of a nominal palm pose (section 3.2)
+//! and, when the open hand or arm at that pose touches an obstacle (the table
+//! under a lying bottle, the board under a plate), raises the palm in steps of
+//! [`LIFT_STEP`] along the world vertical, up to [`max_lift`] of the OCP,
+//! until it is clear. It returns the first clear pose, or the unlifted one
+//! marked blocked.
+//!
+//! Why: the paper centres GRCdes on the OCP, which on a low or lying object
+//! puts the open fingers and the thumb below the support's top, so every
+//! sample of Algorithm 1 around that pose is rejected. Holding the object a
+//! little higher — the contacts move up its sides, which still close (the
+//! exact test decides) — is what a person does with a plate or a lying can.
+//!
+//! How: only obstacle contacts trigger a lift (self-collision and the object
+//! are not helped by it); a lift whose IK fails is skipped. The unlifted pose
+//! is tried first, so a scene whose nominal is already clear is unchanged.
+//!
+//! ```
+//! use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
+//! use tsukami_grasp_planner::{clearance::max_lift, ocp::Ocp};
+//! let lying_can = Ocp {
+//!     region: 0,
+//!     center: Point3::new(0.4, -0.2, 0.75),
+//!     rotation: Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[
+//!         Vector3::y(), Vector3::x(), -Vector3::z(),
+//!     ])),
+//!     extents: Vector3::new(0.12, 0.06, 0.06),
+//!     blocked: [None; 6],
+//! };
+//! assert!((max_lift(&lying_can) - 0.3 * 0.06).abs() < 1e-12);
+//! ```
+
+use nalgebra::{Isometry3, Translation3, Vector3};
+use tsukami_body::collision::CollisionObject;
+use tsukami_body::ik::IkSolver;
+use tsukami_body::kinematics::FkState;
+
+use crate::hand::HandModel;
+use crate::link_sets::LinkSets;
+use crate::ocp::Ocp;
+
+/// Height step of a lift (m).
+pub const LIFT_STEP: f64 = 0.003;
+/// Largest lift as a fraction of the OCP's vertical extent.
+pub const LIFT_FRACTION: f64 = 0.3;
+
+/// The largest lift for a nominal on `ocp` (m): [`LIFT_FRACTION`] of its
+/// extent along the world vertical.
+pub fn max_lift(ocp: &Ocp) -> f64 {
+    let m = ocp.rotation.matrix();
+    let vertical: f64 = (0..3).map(|k| m[(2, k)].abs() * ocp.extents[k]).sum();
+    LIFT_FRACTION * vertical
+}
+
+/// A nominal palm pose with its IK solution.
+pub struct Cleared {
+    /// Palm pose (world).
+    pub palm: Isometry3<f64>,
+    /// IK solution with the grasp type's posture.
+    pub q: Vec<f64>,
+    /// Still blocked at every lift tried.
+    pub blocked: bool,
+}
+
+/// What the open hand must clear: the object and the obstacles.
+pub struct Surroundings<'a> {
+    /// The object.
+    pub object: &'a CollisionObject,
+    /// Obstacles.
+    pub env: &'a [&'a CollisionObject],
+}
+
+/// The nominal `palm`, lifted as little as [`LIFT_STEP`] steps up to `lift`
+/// allow so that `links` clear `around` (see the module docs); `None` when
+/// the unlifted pose has no IK solution. `q0` holds the grasp type's posture.
+#[allow(clippy::too_many_arguments)]
+pub fn clear_nominal(
+    ik: &mut IkSolver,
+    hand: &HandModel,
+    links: &LinkSets,
+    palm: &Isometry3<f64>,
+    (q0, q_init): (&[f64], &[f64]),
+    around: &Surroundings<'_>,
+    lift: f64,
+    fk: &mut FkState,
+) -> Option<Cleared> {
+    let steps = (lift / LIFT_STEP).floor() as usize;
+    let mut first: Option<Cleared> = None;
+    for k in 0..=steps {
+        let up = Vector3::z() * (k as f64 * LIFT_STEP);
+        let p = Isometry3::from_parts(
+            Translation3::from(palm.translation.vector + up),
+            palm.rotation,
+        );
+        let sol = ik.solve(&p, true, q0, Some(q_init));
+        if !sol.ok {
+            if k == 0 {
+                return None;
+            }
+            continue;
+        }
+        hand.robot.forward_kinematics(&sol.q, fk);
+        let blocked = links
+            .blocked(hand, fk, around.object, around.env, true)
+            .is_some();
+        if !blocked {
+            return Some(Cleared {
+                palm: p,
+                q: sol.q,
+                blocked,
+            });
+        }
+        let on_obstacle = links.touches_obstacle(hand, fk, around.env);
+        first.get_or_insert(Cleared {
+            palm: p,
+            q: sol.q,
+            blocked,
+        });
+        if !on_obstacle {
+            break;
+        }
+    }
+    first
+}
