@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use tsukami_scenes::{scene_requests, World};
 
-use crate::demo::{notes, plan_cells, step_cells, DemoScene};
+use crate::demo::{notes, plan_cells, step_cells, DemoScene, PlanOn};
 use crate::picture::{write_pictures, DEFAULT_EYE};
 
 /// Picture size of the report (pixels).
@@ -19,10 +19,15 @@ const PICTURE: (u32, u32) = (800, 600);
 /// Markdown file's path.
 pub fn write_report(dir: &Path, models: &Path, scenes: &[DemoScene], seed: u64) -> Result<PathBuf> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let planned_on = if scenes.iter().any(|s| s.planned_on == PlanOn::Vision) {
+        "where the vision saw the object (on the scene file's pose where it did not find it)"
+    } else {
+        "on the scene file's pose"
+    };
     let mut md = format!(
         "# Tsukami demo report\n\nThe paper's scenes run over the bus (seed {seed}): the \
          vision component finds the object (error against the scene file's pose), the grasp \
-         planner plans on the scene file's pose, the trajectory planner plans rest → grasp → \
+         planner plans {planned_on}, the trajectory planner plans rest → grasp → \
          lift, the controller executes it. \"exact\" is the independent check's verdict \
          (force closure with the object's weight, recomputed from the reply's contacts); \
          \"executed\" is ok when the controller's published state at the end of `close` \
@@ -56,12 +61,19 @@ pub fn write_report(dir: &Path, models: &Path, scenes: &[DemoScene], seed: u64) 
             Vector3::from(DEFAULT_EYE),
         )?;
         writeln!(pictures, "## {}\n", o.scene)?;
-        for note in notes(scene) {
-            writeln!(pictures, "- {note}")?;
+        let mut lines = notes(scene);
+        if scene.planned_on == PlanOn::Vision {
+            lines.insert(0, "planned on the pose the vision saw".to_owned());
+        }
+        for line in &lines {
+            writeln!(pictures, "- {line}")?;
+        }
+        if !lines.is_empty() {
+            pictures.push('\n');
         }
         writeln!(
             pictures,
-            "\n![{}]({png})\n\n3D: [{glb}]({glb}); the components' output: \
+            "![{}]({png})\n\n3D: [{glb}]({glb}); the components' output: \
              [vision](logs/vision-{}.log), [controller](logs/controller-{}.log)\n",
             o.scene, o.scene, o.scene
         )?;
