@@ -147,11 +147,18 @@ enum Command {
 /// Runs the CLI and maps errors to a message and exit status 1.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    // The demo prints its own progress; the host's info lines would only clutter it,
+    // as would zenoh's note that its (disabled) scouting found nobody.
+    let default_filter = match cli.command {
+        Command::Demo(_) => {
+            "warn,zenoh::net::routing=error,zenoh::net::runtime::orchestrator=error"
+        }
+        _ => "warn,tsukami=info,zenoh::net::routing=error",
+    };
     tracing_subscriber::fmt()
         .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| {
-                tracing_subscriber::EnvFilter::new("warn,tsukami=info,zenoh::net::routing=error")
-            }),
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(default_filter)),
         )
         .with_writer(std::io::stderr)
         .init();
