@@ -82,6 +82,23 @@ pub fn grasp_planner_entry(lib_name: &str) -> PluginEntryConfig {
     entry
 }
 
+/// A config entry loading the result viewer with the repository's models, its web
+/// view on a free loopback port (`state` names it).
+pub fn viewer_entry() -> PluginEntryConfig {
+    let mut entry = plugin_entry(
+        tsukami_msgs::keys::ROLE_RESULT_VIEWER,
+        "tsukami_result_viewer",
+    );
+    let mut table = toml::Table::new();
+    table.insert(
+        "models_dir".into(),
+        models_dir().display().to_string().into(),
+    );
+    table.insert("web".into(), "127.0.0.1:0".into());
+    entry.config = Some(table);
+    entry
+}
+
 /// A host on a free loopback port with its own namespace, plus a connected client.
 pub struct TestBus {
     /// The running host (dropped last).

@@ -15,9 +15,8 @@ mod cdp;
 use std::time::{Duration, Instant};
 
 use serde_json::Value;
-use tsukami::config::PluginEntryConfig;
 use tsukami::scenes::run_scene;
-use tsukami_e2e::{models_dir, planner_entry, plugin_entry, test_config, TestBus};
+use tsukami_e2e::{models_dir, planner_entry, test_config, viewer_entry, TestBus};
 use tsukami_msgs::keys::ROLE_RESULT_VIEWER;
 use tsukami_scenes::paper_scene;
 
@@ -25,16 +24,6 @@ const TIMEOUT: Duration = Duration::from_secs(60);
 /// The browser's page size.
 const WIDTH: u32 = 800;
 const HEIGHT: u32 = 600;
-
-/// The result viewer serving its page on a free loopback port.
-fn viewer_entry() -> PluginEntryConfig {
-    let mut entry = plugin_entry(ROLE_RESULT_VIEWER, "tsukami_result_viewer");
-    let mut table = toml::Table::new();
-    table.insert("models_dir".into(), models_dir().display().to_string().into());
-    table.insert("web".into(), "127.0.0.1:0".into());
-    entry.config = Some(table);
-    entry
-}
 
 fn viewer(bus: &TestBus, command: &str, payload: &str) -> Value {
     let key = bus.client.keys().command(ROLE_RESULT_VIEWER, command);
@@ -60,12 +49,22 @@ fn wait_for<T>(what: &str, limit: Duration, mut f: impl FnMut() -> Option<T>) ->
 /// Plans paper scene `name` with `seed` over the bus, checked as the paper
 /// scene tests check it, and waits until the viewer has heard `plans` plans.
 fn plan(bus: &TestBus, name: &str, seed: u64, plans: u64) -> Value {
-    let outcome = run_scene(&bus.client, &models_dir(), paper_scene(name).unwrap(), seed, TIMEOUT);
+    let outcome = run_scene(
+        &bus.client,
+        &models_dir(),
+        paper_scene(name).unwrap(),
+        seed,
+        TIMEOUT,
+    );
     assert!(outcome.ok, "{name}: {:?}", outcome.problem);
-    wait_for("the viewer to follow the plan", Duration::from_secs(10), || {
-        let state = viewer(bus, "state", "{}");
-        (state["counts"]["plans"].as_u64() >= Some(plans)).then_some(state)
-    })
+    wait_for(
+        "the viewer to follow the plan",
+        Duration::from_secs(10),
+        || {
+            let state = viewer(bus, "state", "{}");
+            (state["counts"]["plans"].as_u64() >= Some(plans)).then_some(state)
+        },
+    )
 }
 
 /// RGBA pixels of a PNG and its width.
@@ -142,9 +141,15 @@ fn the_viewer_follows_plans_and_answers_render_glb_and_state_over_the_bus() {
 
     // Bad input: named, and the viewer keeps serving.
     let key = bus.client.keys().command(ROLE_RESULT_VIEWER, "render");
-    let err = bus.client.request_key(&key, br#"{"width": 1}"#, TIMEOUT).unwrap_err();
+    let err = bus
+        .client
+        .request_key(&key, br#"{"width": 1}"#, TIMEOUT)
+        .unwrap_err();
     assert!(err.to_string().contains("width"), "{err}");
-    let err = bus.client.request_key(&key, br#"{"colour": 1}"#, TIMEOUT).unwrap_err();
+    let err = bus
+        .client
+        .request_key(&key, br#"{"colour": 1}"#, TIMEOUT)
+        .unwrap_err();
     assert!(err.to_string().contains("colour"), "{err}");
     assert_eq!(viewer(&bus, "state", "{}")["counts"]["plans"], 1);
 }
@@ -154,7 +159,9 @@ fn on_page(browser: &mut cdp::Browser, name: &str) -> [f64; 2] {
     let at = browser
         .eval(&format!("window.tsukamiViewer.screen({name:?})"))
         .unwrap();
-    let at = at.as_array().unwrap_or_else(|| panic!("{name} is not on the page"));
+    let at = at
+        .as_array()
+        .unwrap_or_else(|| panic!("{name} is not on the page"));
     [at[0].as_f64().unwrap(), at[1].as_f64().unwrap()]
 }
 
@@ -197,7 +204,12 @@ fn the_web_page_draws_the_robot_and_the_can_and_follows_a_new_plan() {
     browser.navigate(&url).unwrap();
     let first = page_shows(&mut browser, 1);
     assert!(
-        browser.eval("document.title").unwrap().as_str().unwrap().contains("fingertip4_mid"),
+        browser
+            .eval("document.title")
+            .unwrap()
+            .as_str()
+            .unwrap()
+            .contains("fingertip4_mid"),
         "the panel names the grasp type"
     );
     let (px, width) = pixels(&shot(&mut browser, "can_breast"));
@@ -217,7 +229,10 @@ fn the_web_page_draws_the_robot_and_the_can_and_follows_a_new_plan() {
     let second = page_shows(&mut browser, 2);
     assert_ne!(second["worldVersion"], first["worldVersion"]);
     let title = browser.eval("document.title").unwrap();
-    assert!(title.as_str().unwrap().contains("fingertip3_mid"), "{title}");
+    assert!(
+        title.as_str().unwrap().contains("fingertip3_mid"),
+        "{title}"
+    );
     let (px, width) = pixels(&shot(&mut browser, "can_waist"));
     let can = on_page(&mut browser, "object");
     let blue = share(&px, width, can, 12, is_blue);

@@ -27,10 +27,15 @@ pub fn find_chromium() -> Option<PathBuf> {
         return Some(PathBuf::from(p));
     }
     let path = std::env::var_os("PATH")?;
-    ["chromium", "chromium-browser", "google-chrome", "google-chrome-stable"]
-        .iter()
-        .flat_map(|name| std::env::split_paths(&path).map(move |d| d.join(name)))
-        .find(|p| p.is_file())
+    [
+        "chromium",
+        "chromium-browser",
+        "google-chrome",
+        "google-chrome-stable",
+    ]
+    .iter()
+    .flat_map(|name| std::env::split_paths(&path).map(move |d| d.join(name)))
+    .find(|p| p.is_file())
 }
 
 /// A running headless browser with one page attached.
@@ -110,10 +115,20 @@ impl Browser {
                 message.clear();
             }
         });
-        let mut browser = Browser { child, to, from: rx, next: 0, session: None, profile };
+        let mut browser = Browser {
+            child,
+            to,
+            from: rx,
+            next: 0,
+            session: None,
+            profile,
+        };
         let target = browser.send("Target.createTarget", json!({"url": "about:blank"}))?;
         let target = target["targetId"].clone();
-        let attached = browser.send("Target.attachToTarget", json!({"targetId": target, "flatten": true}))?;
+        let attached = browser.send(
+            "Target.attachToTarget",
+            json!({"targetId": target, "flatten": true}),
+        )?;
         browser.session = attached["sessionId"].as_str().map(str::to_owned);
         browser.send(
             "Emulation.setDeviceMetricsOverride",
