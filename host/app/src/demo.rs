@@ -52,7 +52,7 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 use step::{Step, StepStatus};
 use tsukami_msgs::host::PluginsReply;
-use tsukami_msgs::keys::ROLE_TRAJECTORY_PLANNER;
+use tsukami_msgs::keys::{ROLE_RESULT_VIEWER, ROLE_TRAJECTORY_PLANNER};
 use tsukami_msgs::planner::ObjectShape;
 use tsukami_scenes::{scene_requests, PaperScene, PAPER_SCENES};
 use vision::VisionCheck;
@@ -294,6 +294,12 @@ impl Demo<'_> {
             let roles = plugin.roles.join(",");
             println!("  {roles:<20} {} {}", plugin.name, plugin.version);
         }
+        if let Some(url) = self.live_view(listing) {
+            println!(
+                "Live view: {url} (the result viewer follows each grasp and the robot as it moves; \
+                 --speed 1 to watch in real time)"
+            );
+        }
         println!("Components, started for each scene on the same bus:");
         let rows = [
             ("vision", &self.vision_exe, "simulated head camera"),
@@ -315,6 +321,22 @@ impl Demo<'_> {
             PlanOn::Vision => "Grasps are planned where the vision saw the object (on the scene file's pose where it did not find it); judged on the scene file's.",
         });
         println!("\n{}", table::header());
+    }
+
+    /// The result viewer's web page, when the host has the viewer and it serves one.
+    fn live_view(&self, listing: &PluginsReply) -> Option<String> {
+        listing
+            .plugins
+            .iter()
+            .any(|p| p.roles.iter().any(|r| r == ROLE_RESULT_VIEWER))
+            .then_some(())?;
+        let timeout = Duration::from_secs(5);
+        let reply = self
+            .client
+            .command(ROLE_RESULT_VIEWER, "state", b"{}", timeout)
+            .ok()?;
+        let state: serde_json::Value = serde_json::from_slice(&reply).ok()?;
+        state["web"]["url"].as_str().map(str::to_owned)
     }
 
     /// Starts component `name` for `scene` with `args` after the bus options.
