@@ -16,8 +16,8 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 use tsukami::scenes::run_scene;
-use tsukami_e2e::{models_dir, planner_entry, test_config, viewer_entry, TestBus};
-use tsukami_msgs::keys::ROLE_RESULT_VIEWER;
+use tsukami_e2e::{models_dir, planner_entry, plugin_entry, test_config, viewer_entry, TestBus};
+use tsukami_msgs::keys::{ROLE_RESULT_VIEWER, ROLE_TRAJECTORY_PLANNER};
 use tsukami_scenes::paper_scene;
 
 const TIMEOUT: Duration = Duration::from_secs(60);
@@ -48,7 +48,7 @@ fn wait_for<T>(what: &str, limit: Duration, mut f: impl FnMut() -> Option<T>) ->
 
 /// Plans paper scene `name` with `seed` over the bus, checked as the paper
 /// scene tests check it, and waits until the viewer has heard `plans` plans.
-fn plan(bus: &TestBus, name: &str, seed: u64, plans: u64) -> Value {
+fn plan(bus: &TestBus, name: &str, seed: u64, plans: u64) -> (Value, Value) {
     let outcome = run_scene(
         &bus.client,
         &models_dir(),
@@ -57,13 +57,17 @@ fn plan(bus: &TestBus, name: &str, seed: u64, plans: u64) -> Value {
         TIMEOUT,
     );
     assert!(outcome.ok, "{name}: {:?}", outcome.problem);
-    wait_for(
+    let state = wait_for(
         "the viewer to follow the plan",
         Duration::from_secs(10),
         || {
             let state = viewer(bus, "state", "{}");
             (state["counts"]["plans"].as_u64() >= Some(plans)).then_some(state)
         },
+    );
+    (
+        state,
+        serde_json::to_value(outcome.result.unwrap()).unwrap(),
     )
 }
 
@@ -113,7 +117,7 @@ fn share(px: &[[u8; 3]], width: u32, at: [f64; 2], radius: i64, test: fn([u8; 3]
 #[test]
 fn the_viewer_follows_plans_and_answers_render_glb_and_state_over_the_bus() {
     let bus = TestBus::start(test_config(vec![planner_entry(), viewer_entry()]));
-    let state = plan(&bus, "can_breast", 0, 1);
+    let (state, _) = plan(&bus, "can_breast", 0, 1);
     assert_eq!(state["plan"]["grasp_type"], "fingertip4_mid", "{state}");
     assert!(state["plan"]["margin"].as_f64().unwrap() > 0.0);
     assert_eq!(state["contacts"].as_array().unwrap().len(), 4);
@@ -178,6 +182,47 @@ fn page_shows(browser: &mut cdp::Browser, plans: u64) -> Value {
     })
 }
 
+fn motion_entry() -> tsukami::config::PluginEntryConfig {
+    let mut entry = plugin_entry(ROLE_TRAJECTORY_PLANNER, "tsukami_trajectory_planner");
+    let mut table = toml::Table::new();
+    table.insert(
+        "models_dir".into(),
+        models_dir().display().to_string().into(),
+    );
+    entry.config = Some(table);
+    entry
+}
+
+/// Plans the motion to `grasp`; the page's time slider then moves the hand
+/// from where the motion starts (at rest) to where it ends (lifted).
+fn the_slider_plays_the_planned_motion(bus: &TestBus, browser: &mut cdp::Browser, grasp: Value) {
+    let request = serde_json::json!({"grasp": grasp, "seed": 0}).to_string();
+    bus.client
+        .command(ROLE_TRAJECTORY_PLANNER, "plan", request.as_bytes(), TIMEOUT)
+        .expect("a motion to the grasp");
+    let frames = wait_for("the page to load the motion", TIMEOUT, || {
+        let motions = browser.eval("window.tsukamiViewer.motions").ok()?;
+        let last = browser
+            .eval("Number(document.getElementById('time').max)")
+            .ok()?;
+        (motions.as_u64() >= Some(1) && last.as_u64() > Some(0)).then(|| last.as_u64().unwrap())
+    });
+    let mut palm_at = |frame: u64| {
+        let js = format!(
+            "(() => {{ const s = document.getElementById('time'); s.value = {frame}; \
+             s.dispatchEvent(new Event('input')); return window.tsukamiViewer.screen('r_palm'); }})()"
+        );
+        let at = browser.eval(&js).unwrap();
+        [at[0].as_f64().unwrap(), at[1].as_f64().unwrap()]
+    };
+    let (start, end) = (palm_at(0), palm_at(frames));
+    let moved = (start[0] - end[0]).hypot(start[1] - end[1]);
+    assert!(
+        moved > 20.0,
+        "the palm moved {moved} px along the motion: {start:?} -> {end:?}"
+    );
+}
+
 /// A screenshot, also kept as `<target tmp>/viewer_browser/<name>.png` to look at.
 fn shot(browser: &mut cdp::Browser, name: &str) -> Vec<u8> {
     let png = browser.screenshot().unwrap();
@@ -189,13 +234,17 @@ fn shot(browser: &mut cdp::Browser, name: &str) -> Vec<u8> {
 }
 
 #[test]
-fn the_web_page_draws_the_robot_and_the_can_and_follows_a_new_plan() {
+fn the_web_page_draws_robot_and_can_plays_the_motion_and_follows_a_new_plan() {
     let Some(chromium) = cdp::find_chromium() else {
         eprintln!("viewer_browser: NOT RUN: no chromium on this machine (.ci/run installs Debian's `chromium`; or set TSUKAMI_CHROMIUM)");
         return;
     };
-    let bus = TestBus::start(test_config(vec![planner_entry(), viewer_entry()]));
-    let state = plan(&bus, "can_breast", 0, 1);
+    let bus = TestBus::start(test_config(vec![
+        planner_entry(),
+        viewer_entry(),
+        motion_entry(),
+    ]));
+    let (state, grasp) = plan(&bus, "can_breast", 0, 1);
     let url = state["web"]["url"].as_str().unwrap().to_owned();
     let mut browser = match cdp::Browser::launch(&chromium, WIDTH, HEIGHT) {
         Ok(b) => b,
@@ -223,6 +272,7 @@ fn the_web_page_draws_the_robot_and_the_can_and_follows_a_new_plan() {
     assert!(blue > 0.15, "the can (blue) at {can:?}: {blue}");
     assert!(orange > 0.2, "the hand (orange) at {palm:?}: {orange}");
     assert!(grey > 0.2, "the arm (grey) at {forearm:?}: {grey}");
+    the_slider_plays_the_planned_motion(&bus, &mut browser, grasp);
 
     // A new plan in another world: the open page follows it.
     plan(&bus, "can_waist", 0, 2);

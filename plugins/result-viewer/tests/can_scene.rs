@@ -26,7 +26,7 @@ fn models() -> PathBuf {
 /// The planned can grasp, its world and its drawing.
 fn can_breast() -> (PlanReply, World, Drawing) {
     let req = scene_requests(&models().join("scenes/can_breast.toml")).unwrap();
-    let p = Planner::new(&models());
+    let p = Planner::new(models());
     p.set_robot(&req.robot).unwrap();
     p.set_object(&req.object).unwrap();
     p.set_env(&req.env).unwrap();
