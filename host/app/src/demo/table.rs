@@ -137,3 +137,48 @@ pub fn notes(s: &DemoScene) -> Vec<String> {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::demo::PlanOn;
+
+    fn scene() -> DemoScene {
+        DemoScene {
+            plan: SceneOutcome {
+                scene: "can_breast".into(),
+                expected: "4-finger fingertip".into(),
+                ok: true,
+                problem: None,
+                result: None,
+                regions: 1,
+                arm_only: None,
+                plan_ms: 1.0,
+                weight_scale: None,
+            },
+            planned_on: PlanOn::Scene,
+            vision: Step::failed("infeasible: 'can_350ml' not found: no cluster", None),
+            motion: Step::not_run("no grasp"),
+            execution: Step::not_run("tsukami-controller not found in /x"),
+        }
+    }
+
+    #[test]
+    fn cells_say_not_found_not_run_and_failed() {
+        let mut s = scene();
+        assert_eq!(step_cells(&s), ["not found", "not run", "-", "not run"]);
+        s.vision = Step::failed("bus error", None);
+        s.execution = Step::failed("the grasp part ended `fault`", None);
+        assert_eq!(step_cells(&s), ["failed", "not run", "-", "FAILED"]);
+        assert!(!s.passed());
+        // Only failures get a note; "not run" is said once, in the header.
+        assert_eq!(
+            notes(&s),
+            [
+                "vision: bus error",
+                "execution: the grasp part ended `fault`"
+            ]
+        );
+        assert!(row(&s).starts_with("can_breast "));
+    }
+}
