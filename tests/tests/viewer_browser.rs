@@ -16,7 +16,10 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 use tsukami::scenes::run_scene;
-use tsukami_e2e::{models_dir, planner_entry, plugin_entry, test_config, viewer_entry, TestBus};
+use tsukami_e2e::{
+    cli_plugins_listing, models_dir, planner_entry, plugin_entry, spawn_tsukami, test_config,
+    viewer_entry, TestBus,
+};
 use tsukami_msgs::keys::{ROLE_RESULT_VIEWER, ROLE_TRAJECTORY_PLANNER};
 use tsukami_scenes::paper_scene;
 
@@ -287,4 +290,38 @@ fn the_web_page_draws_robot_and_can_plays_the_motion_and_follows_a_new_plan() {
     let can = on_page(&mut browser, "object");
     let blue = share(&px, width, can, 12, is_blue);
     assert!(blue > 0.15, "the moved can (blue) at {can:?}: {blue}");
+}
+
+#[test]
+fn the_default_host_loads_the_viewer_and_prints_where_its_page_is() {
+    let port = tsukami::bus::free_loopback_port().unwrap();
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let namespace = format!("viewer-default-{port}");
+    let mut host = spawn_tsukami(&["run", "--listen", &endpoint, "--namespace", &namespace]);
+    let listing = cli_plugins_listing(&endpoint, &namespace);
+    let viewer = listing["plugins"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["roles"][0] == ROLE_RESULT_VIEWER)
+        .unwrap_or_else(|| panic!("no result-viewer in {listing}"));
+    assert_eq!(viewer["name"], "tsukami-result-viewer");
+    // The log names the page's address (17448, or a free port when taken).
+    let stderr = host.0.stderr.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        use std::io::BufRead;
+        for line in std::io::BufReader::new(stderr)
+            .lines()
+            .map_while(Result::ok)
+        {
+            if line.contains("result viewer: open http://127.0.0.1:") {
+                let _ = tx.send(line);
+            }
+        }
+    });
+    let line = rx
+        .recv_timeout(TIMEOUT)
+        .expect("the host prints the viewer's address");
+    assert!(line.contains("in a browser"), "{line}");
 }
