@@ -17,6 +17,15 @@
 //! seed give the same path on any machine. Nearest neighbours are found by a linear
 //! scan, which is fast enough for the few thousand nodes a budget allows.
 //!
+//! Edges are checked lazily (as in Lazy PRM: R. Bohlin and L. E. Kavraki, "Path
+//! planning using lazy PRM", ICRA 2000): growing a tree checks each new edge
+//! coarsely — its end and every [`GROWTH_STRIDE`]-th of its points, the head of
+//! its [`coarse_to_fine`] order; when the trees meet, the edges of the joined path
+//! get the rest of their points checked, each edge once. A blocked edge cuts its
+//! node and everything grown from it off its tree, and sampling goes on. Most tree
+//! edges never lie on a joined path, so most are never checked finely; every
+//! point of every edge of the returned path has been.
+//!
 //! ```
 //! use tsukami_trajectory_planner::rrt_connect::{plan, Problem, RrtParams, Validity, SegmentSteps};
 //! // A unit square with a wall at x = 0.5 that has a gap at y > 0.8.
@@ -117,12 +126,33 @@ pub fn segment_valid(
     if n == usize::MAX {
         return false;
     }
+    points_valid(validity, a, b, n, coarse_to_fine(n))
+}
+
+/// Checks the points `order` (indices into `1..=n`) of `a → b` split in `n` steps.
+fn points_valid(
+    validity: &mut impl Validity,
+    a: &[f64],
+    b: &[f64],
+    n: usize,
+    mut order: impl Iterator<Item = usize>,
+) -> bool {
     let mut q = vec![0.0; a.len()];
-    coarse_to_fine(n).all(|i| {
+    order.all(|i| {
         let t = i as f64 / n as f64;
         lerp_into(a, b, t, &mut q);
         validity.is_valid(&q)
     })
+}
+
+/// Growing a tree checks every `GROWTH_STRIDE`-th point of a new edge (and its
+/// end); the others wait until the edge lies on a joined path.
+pub const GROWTH_STRIDE: usize = 8;
+
+/// How many of [`coarse_to_fine`]`(n)` come first and are `n` or multiples of
+/// `GROWTH_STRIDE` (a power of two): the points a growing tree checks.
+fn growth_points(n: usize) -> usize {
+    1 + (n - 1) / GROWTH_STRIDE
 }
 
 /// The indices `1..=n`, each once: `n` first, then bisection order — the
@@ -160,10 +190,14 @@ fn distance(a: &[f64], b: &[f64]) -> f64 {
         .sqrt()
 }
 
-/// One tree: nodes and the index of each node's parent.
+/// One tree: nodes, the index of each node's parent, the steps of the edge to
+/// the parent (0 once it is checked at every point), and whether the node has
+/// been cut off.
 struct Tree {
     nodes: Vec<Vec<f64>>,
     parent: Vec<usize>,
+    unchecked: Vec<usize>,
+    cut: Vec<bool>,
 }
 
 #[derive(PartialEq)]
@@ -178,12 +212,17 @@ impl Tree {
         Tree {
             nodes: vec![root.to_vec()],
             parent: vec![0],
+            unchecked: vec![0],
+            cut: vec![false],
         }
     }
 
     fn nearest(&self, q: &[f64]) -> usize {
         let mut best = (0, f64::INFINITY);
         for (i, n) in self.nodes.iter().enumerate() {
+            if self.cut[i] {
+                continue;
+            }
             let d = distance(n, q);
             if d < best.1 {
                 best = (i, d);
@@ -192,10 +231,13 @@ impl Tree {
         best.0
     }
 
-    /// One RRT extension towards `target`.
+    /// One RRT extension towards `target`; the new edge is checked coarsely
+    /// ([`growth_points`]), its end not when it is `target` and `target_free`
+    /// says `target` was checked already.
     fn extend<V: Validity, S: SegmentSteps>(
         &mut self,
         target: &[f64],
+        target_free: bool,
         step: f64,
         validity: &mut V,
         steps: &S,
@@ -210,15 +252,53 @@ impl Tree {
             lerp_into(from, target, step / d, &mut q);
             (q, false)
         };
-        if !segment_valid(validity, steps, from, &new) {
+        let n = steps.steps(from, &new);
+        if n == usize::MAX {
+            return Extend::Trapped;
+        }
+        let coarse = coarse_to_fine(n)
+            .take(growth_points(n))
+            .skip(usize::from(reached && target_free));
+        if !points_valid(validity, from, &new, n, coarse) {
             return Extend::Trapped;
         }
         self.nodes.push(new);
         self.parent.push(near);
+        self.unchecked.push(n);
+        self.cut.push(false);
         if reached {
             Extend::Reached
         } else {
             Extend::Advanced
+        }
+    }
+
+    /// Checks the points left unchecked on the edges between node `i` and the
+    /// root, from `i` on; the first blocked edge cuts its lower node and that
+    /// node's descendants off. True when the whole path is free.
+    fn verify<V: Validity>(&mut self, mut i: usize, validity: &mut V) -> bool {
+        while i != 0 {
+            let (p, n) = (self.parent[i], self.unchecked[i]);
+            if n > 0 {
+                let rest = coarse_to_fine(n).skip(growth_points(n));
+                if !points_valid(validity, &self.nodes[p], &self.nodes[i], n, rest) {
+                    self.cut_off(i);
+                    return false;
+                }
+                self.unchecked[i] = 0;
+            }
+            i = p;
+        }
+        true
+    }
+
+    /// Cuts node `i` and its descendants (stored after it) off the tree.
+    fn cut_off(&mut self, i: usize) {
+        self.cut[i] = true;
+        for k in i + 1..self.nodes.len() {
+            if self.cut[self.parent[k]] {
+                self.cut[k] = true;
+            }
         }
     }
 
@@ -294,18 +374,20 @@ pub fn plan_counted<V: Validity, S: SegmentSteps>(
             let [x, y] = &mut trees;
             [y, x]
         };
-        if ta.extend(&sample, params.step, validity, steps) == Extend::Trapped {
+        if ta.extend(&sample, false, params.step, validity, steps) == Extend::Trapped {
             continue;
         }
         let newest = ta.nodes.len() - 1;
         let target = ta.nodes[newest].clone();
         let mut outcome = Extend::Advanced;
         while outcome == Extend::Advanced {
-            outcome = tb.extend(&target, params.step, validity, steps);
+            outcome = tb.extend(&target, true, params.step, validity, steps);
         }
-        if outcome == Extend::Reached {
+        let joined = tb.nodes.len() - 1;
+        if outcome == Extend::Reached && ta.verify(newest, validity) && tb.verify(joined, validity)
+        {
             let mut from_a = ta.path_to(newest);
-            let mut from_b = tb.path_to(tb.nodes.len() - 1);
+            let mut from_b = tb.path_to(joined);
             from_b.reverse();
             from_b.remove(0); // the connecting node appears in both
             from_a.extend(from_b);
@@ -367,6 +449,32 @@ mod tests {
         for w in path.windows(2) {
             let mut fine = Wall { checks: 0 };
             assert!(segment_valid(&mut fine, &Res(0.001), &w[0], &w[1]));
+        }
+    }
+
+    #[test]
+    fn a_wall_thinner_than_the_growth_stride_is_caught_on_the_joined_path() {
+        // 3 cm thick: growing trees check every 8th point of 1 cm steps and can
+        // jump it; the joined path's edges are checked at every point.
+        struct Thin;
+        impl Validity for Thin {
+            fn is_valid(&mut self, q: &[f64]) -> bool {
+                !((0.485..=0.515).contains(&q[0]) && q[1] < 0.8)
+            }
+        }
+        for seed in 0..20 {
+            let params = RrtParams {
+                seed,
+                step: 0.3,
+                ..RrtParams::default()
+            };
+            let path = plan(&problem(), &params, &mut Thin, &Res(0.01), &|| false).unwrap();
+            for w in path.windows(2) {
+                assert!(
+                    segment_valid(&mut Thin, &Res(0.001), &w[0], &w[1]),
+                    "seed {seed}: {w:?} crosses the wall"
+                );
+            }
         }
     }
 
