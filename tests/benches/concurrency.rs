@@ -4,10 +4,13 @@
 //! when `TSUKAMI_BEFORE` names the `tsukami` binary of an older build (with its
 //! planner plugin beside it and `TSUKAMI_BEFORE_MODELS` its models folder),
 //! plan p50 over the bus per paper scene, that build against this one, in the
-//! same run.
+//! same run, with how many of each build's grasps pass the independent check
+//! (`tsukami_scenes::verify`: penetration, contacts on the surface, exact force
+//! closure with the weight) on this build's world.
 //!
 //! Run: `cargo bench -p tsukami-e2e --bench concurrency`.
 
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -15,15 +18,17 @@ use tsukami::bus::{free_loopback_port, BusConfig};
 use tsukami::client::BusClient;
 use tsukami_e2e::{models_dir, planner_entry, test_config, ChildGuard, TestBus};
 use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER};
-use tsukami_msgs::planner::PlanOptions;
-use tsukami_scenes::{scene_requests, PAPER_SCENES};
+use tsukami_msgs::planner::{PlanOptions, PlanReply};
+use tsukami_scenes::{scene_requests, verify, Tolerances, World, PAPER_SCENES};
 
 const T: Duration = Duration::from_secs(120);
-const PLANS_PER_CLIENT: u64 = 24;
+const PLANS_PER_CLIENT: u64 = 100;
 const SEEDS: u64 = 32;
 
-fn set_scene(c: &BusClient, scene: &str) {
-    let req = scene_requests(&models_dir().join("scenes").join(format!("{scene}.toml"))).unwrap();
+/// Sets `scene` from `models`' scenes folder (each build reads its own models:
+/// their grasp-type files differ between versions).
+fn set_scene(c: &BusClient, models: &Path, scene: &str) {
+    let req = scene_requests(&models.join("scenes").join(format!("{scene}.toml"))).unwrap();
     for (cmd, body) in [
         (planner::SET_ROBOT, serde_json::to_vec(&req.robot).unwrap()),
         (
@@ -36,16 +41,33 @@ fn set_scene(c: &BusClient, scene: &str) {
     }
 }
 
-fn plan(c: &BusClient, seed: u64) -> Duration {
+/// One plan's round trip, and its reply when it found a grasp (an `infeasible`
+/// or other error reply still counts its time: the bench reports the failures).
+fn plan_reply(c: &BusClient, seed: u64) -> (Duration, Option<Vec<u8>>) {
     let body = serde_json::to_vec(&PlanOptions {
         seed,
         ..PlanOptions::default()
     })
     .unwrap();
     let start = Instant::now();
-    c.command(ROLE_GRASP_PLANNER, planner::PLAN, &body, T)
-        .expect("plan");
-    start.elapsed()
+    let reply = c.command(ROLE_GRASP_PLANNER, planner::PLAN, &body, T).ok();
+    (start.elapsed(), reply)
+}
+
+fn plan(c: &BusClient, seed: u64) -> (Duration, bool) {
+    let (t, reply) = plan_reply(c, seed);
+    (t, reply.is_some())
+}
+
+/// How many of `replies` (found grasps) pass the independent check on `world`.
+fn verified(world: &World, replies: &[Vec<u8>]) -> usize {
+    replies
+        .iter()
+        .filter(|r| {
+            serde_json::from_slice::<PlanReply>(r)
+                .is_ok_and(|reply| verify(world, &reply, &Tolerances::default()).is_ok())
+        })
+        .count()
 }
 
 /// Plans per second with `clients` clients, each on its own session.
@@ -83,8 +105,8 @@ fn pool_table() {
         let mut entry = planner_entry();
         entry.workers = Some(pool);
         let bus = TestBus::start(test_config(vec![entry]));
-        set_scene(&bus.client, "can_breast");
-        plan(&bus.client, 0);
+        set_scene(&bus.client, &models_dir(), "can_breast");
+        assert!(plan(&bus.client, 0).1, "can_breast plans");
         for (c, clients) in [1u64, 2, 4].into_iter().enumerate() {
             rows[c][p] = throughput(&bus, clients);
         }
@@ -119,23 +141,32 @@ fn before_after(before: &str, before_models: &str) {
     old.wait_for_host(Duration::from_secs(30))
         .expect("the older host answers");
     let new = TestBus::start(test_config(vec![planner_entry()]));
-    println!("plan p50 over the bus, {SEEDS} seeds, older build vs this build (same run):");
+    println!("plan p50 over the bus, {SEEDS} seeds, older build vs this build (same run);");
+    println!("verified: replies with a grasp that pass tsukami_scenes::verify on this build's world");
     println!(
-        "{:<11} {:>10} {:>10} {:>9}",
-        "scene", "before ms", "after ms", "after/bef"
+        "{:<11} {:>10} {:>10} {:>9} {:>13}",
+        "scene", "before ms", "after ms", "after/bef", "verified b/a"
     );
     for scene in PAPER_SCENES {
-        let mut p50 = Vec::new();
-        for c in [&old, &new.client] {
-            set_scene(c, scene.name);
-            p50.push(median_ms((0..SEEDS).map(|s| plan(c, s)).collect()));
+        let (mut p50, mut ok) = (Vec::new(), Vec::new());
+        let path = models_dir().join("scenes").join(format!("{}.toml", scene.name));
+        let r = scene_requests(&path).unwrap();
+        let world = World::from_requests(&models_dir(), &r.robot, &r.object, &r.env).unwrap();
+        for (c, models) in [(&old, Path::new(before_models)), (&new.client, &models_dir())] {
+            set_scene(c, models, scene.name);
+            let (times, replies): (Vec<_>, Vec<_>) = (0..SEEDS).map(|s| plan_reply(c, s)).unzip();
+            let found: Vec<Vec<u8>> = replies.into_iter().flatten().collect();
+            ok.push(verified(&world, &found));
+            p50.push(median_ms(times));
         }
         println!(
-            "{:<11} {:>10.2} {:>10.2} {:>8.2}x",
+            "{:<11} {:>10.2} {:>10.2} {:>8.2}x {:>6}/{:<6}",
             scene.name,
             p50[0],
             p50[1],
-            p50[1] / p50[0]
+            p50[1] / p50[0],
+            ok[0],
+            ok[1]
         );
     }
 }
