@@ -124,6 +124,13 @@ fn the_viewer_follows_plans_and_answers_render_glb_and_state_over_the_bus() {
     assert_eq!(state["plan"]["grasp_type"], "fingertip4_mid", "{state}");
     assert!(state["plan"]["margin"].as_f64().unwrap() > 0.0);
     assert_eq!(state["contacts"].as_array().unwrap().len(), 4);
+    // The object's OCP boxes, from the host's published set_object summary; the
+    // grasped one marked.
+    let ocp = state["ocp"].as_array().unwrap();
+    assert!(!ocp.is_empty(), "{state}");
+    let chosen: Vec<_> = ocp.iter().filter(|b| b["chosen"] == true).collect();
+    assert_eq!(chosen.len(), 1, "{state}");
+    assert_eq!(chosen[0]["region"], state["plan"]["ocp_region"]);
     let url = state["web"]["url"].as_str().expect("the page's address");
     assert!(url.starts_with("http://127.0.0.1:"), "{url}");
 

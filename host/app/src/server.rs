@@ -65,14 +65,15 @@ struct Worker {
 /// the reply's JSON or `{"error": …}`), so the result viewer follows plans it did not
 /// ask for. zenoh's default for a put drops rather than waits on congestion: never
 /// delays the worker.
-struct ResultOut {
-    session: zenoh::Session,
-    keys: KeySpace,
-    role: String,
+pub(crate) struct ResultOut {
+    pub(crate) session: zenoh::Session,
+    pub(crate) keys: KeySpace,
+    /// The role (or `world`) whose prefix the results go under.
+    pub(crate) role: String,
 }
 
 impl ResultOut {
-    fn publish(&self, command: &str, bytes: Vec<u8>) {
+    pub(crate) fn publish(&self, command: &str, bytes: Vec<u8>) {
         let key = self.keys.command(&self.role, &format!("result/{command}"));
         let put = self.session.put(&key, bytes);
         if let Err(e) = put.encoding(Encoding::APPLICATION_JSON).wait() {

@@ -33,7 +33,7 @@ use tsukami_plugin_api::CallError;
 use zenoh::query::{Query, Queryable};
 use zenoh::Wait;
 
-use crate::server::{check_payload, reply_error, reply_json};
+use crate::server::{check_payload, reply_error, reply_json, ResultOut};
 
 /// A plugin that shares the world.
 pub struct Member {
@@ -124,7 +124,12 @@ fn record(state: &mut WorldState, change: WorldChange, version: u64) {
     }
 }
 
-fn serve(members: Vec<Member>, state: Arc<Mutex<WorldState>>, changes: mpsc::Receiver<Change>) {
+fn serve(
+    members: Vec<Member>,
+    state: Arc<Mutex<WorldState>>,
+    changes: mpsc::Receiver<Change>,
+    results: ResultOut,
+) {
     while let Ok(Change { command, query }) = changes.recv() {
         let bytes = query
             .payload()
@@ -146,7 +151,9 @@ fn serve(members: Vec<Member>, state: Arc<Mutex<WorldState>>, changes: mpsc::Rec
                     change,
                     version,
                 );
-                reply_json(&query, reply);
+                reply_json(&query, reply.clone());
+                // `<ns>/world/result/<command>`: what the viewer draws OCP boxes from.
+                results.publish(&command, reply);
             }
             Err(e) => reply_error(&query, e),
         }
@@ -156,7 +163,12 @@ fn serve(members: Vec<Member>, state: Arc<Mutex<WorldState>>, changes: mpsc::Rec
 impl WorldHub {
     /// Starts the hub for `members` (the plugins declaring `world`); `max_queue`
     /// changes may wait, more are answered `busy`.
-    pub fn start(members: Vec<Member>, max_queue: usize) -> Result<WorldHub> {
+    /// Accepted changes' replies are published through `results`.
+    pub(crate) fn start(
+        members: Vec<Member>,
+        max_queue: usize,
+        results: ResultOut,
+    ) -> Result<WorldHub> {
         let roles = members.iter().map(|m| m.role.clone()).collect();
         let state = Arc::new(Mutex::new(WorldState {
             plugins: roles,
@@ -166,7 +178,7 @@ impl WorldHub {
         let shared = state.clone();
         let thread = std::thread::Builder::new()
             .name("world".into())
-            .spawn(move || serve(members, shared, changes))
+            .spawn(move || serve(members, shared, changes, results))
             .context("spawning the world thread")?;
         Ok(WorldHub {
             queue,
@@ -299,7 +311,12 @@ pub fn start(
     if members.is_empty() {
         return Ok(None);
     }
-    let hub = Arc::new(WorldHub::start(members, config.limits.max_queue)?);
+    let results = ResultOut {
+        session: session.clone(),
+        keys: keys.clone(),
+        role: world::PREFIX.to_owned(),
+    };
+    let hub = Arc::new(WorldHub::start(members, config.limits.max_queue, results)?);
     queryables.push(hub.serve_keys(session, keys, config.limits.max_payload_bytes)?);
     Ok(Some(hub))
 }

@@ -31,7 +31,8 @@ controls.target.set(0.4, -0.2, 0.9);
 
 const bodies = new THREE.Group();   // links, object, obstacles
 const marks = new THREE.Group();    // contacts and friction cones
-scene.add(bodies, marks);
+const boxes = new THREE.Group();    // the object's OCP boxes
+scene.add(bodies, marks, boxes);
 let links = [];                     // one THREE.Group per robot link
 let object = null;                  // the object's THREE.Group
 let framed = null;                  // the object the camera was aimed at
@@ -116,6 +117,19 @@ function showContacts(contacts) {
   }
 }
 
+// OCP boxes as edges; the one the plan grasped in bright yellow.
+function showBoxes(ocp) {
+  clear(boxes);
+  for (const b of ocp) {
+    const edges = new THREE.EdgesGeometry(new THREE.BoxGeometry(...b.extents));
+    const lines = new THREE.LineSegments(edges, new THREE.LineBasicMaterial({ color: b.chosen ? 0xffd400 : 0x9a9a60 }));
+    lines.position.set(b.pose[0], b.pose[1], b.pose[2]);
+    lines.quaternion.set(b.pose[3], b.pose[4], b.pose[5], b.pose[6]).normalize();
+    lines.name = `ocp ${b.region}`;
+    boxes.add(lines);
+  }
+}
+
 function posture(poses) {
   if (!poses) return;
   poses.forEach((p, i) => { if (links[i]) place(links[i], p); });
@@ -132,7 +146,7 @@ function panel(s) {
   if (plan && plan.error) row('plan', esc(plan.error), 'error');
   else if (plan) {
     row('grasp type', esc(plan.grasp_type));
-    row('face', `${esc(plan.ocp_region)}: ${esc(plan.face)}`);
+    row('OCP region, face', `${esc(plan.ocp_region)} of ${(s.ocp || []).length}, ${esc(plan.face)}`);
     row('margin', `${fmt(plan.margin)}${plan.exact_resists_weight ? ' (holds the weight)' : ''}`);
     row('joints beyond the arm', plan.joints_used.length ? esc(plan.joints_used.join(', ')) : 'none');
     const t = plan.timing_ms;
@@ -141,7 +155,10 @@ function panel(s) {
   } else row('plan', 'none yet');
   const motion = s.motion;
   if (motion && motion.error) row('motion', esc(motion.error), 'error');
-  else if (motion) row('motion', `${fmt(motion.duration, 2)} s, ${motion.points} points, planned in ${fmt(motion.planning_ms, 1)} ms`);
+  else if (motion) {
+    const stale = motion.world_version !== s.world_version ? ` (in world v${motion.world_version})` : '';
+    row('motion', `${fmt(motion.duration, 2)} s, ${motion.points} points, planned in ${fmt(motion.planning_ms, 1)} ms${stale}`);
+  }
   if (s.controller) row('controller', `${esc(s.controller.status)} at ${fmt(s.controller.time, 2)} s`);
   if (s.vision) row('vision', `${esc(s.vision.object)}: fit ${fmt(s.vision.fit_error, 4)} m, confidence ${fmt(s.vision.confidence, 2)}`);
   row('results', `${s.counts.plans} plans, ${s.counts.motions} motions`);
@@ -189,6 +206,7 @@ async function apply(s) {
     if (follow.checked && s.controller) posture(s.controller.links);
     else posture(s.posture && s.posture.links);
     showContacts(s.contacts || []);
+    showBoxes(s.ocp || []);
     panel(s);
     view.generation = s.generation;
     view.plans = s.counts.plans;

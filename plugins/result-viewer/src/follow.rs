@@ -1,7 +1,8 @@
 //! Following the bus: the results the host publishes and the components' streams.
 //!
-//! What: [`follow`] starts one thread per followed key — grasp plan results
-//! (`<ns>/planner/result/plan`), motion results (`<ns>/motion/result/plan`),
+//! What: [`follow`] starts one thread per followed key — the object's
+//! summary with its OCP boxes (`<ns>/world/result/set_object`), grasp plan
+//! results (`<ns>/planner/result/plan`), motion results (`<ns>/motion/result/plan`),
 //! the controller's state (`<ns>/controller/state`) and the vision poses
 //! (`<ns>/vision/pose/*`) — each putting what arrives into the [`Board`].
 //!
@@ -27,7 +28,8 @@ use crate::latest::{Board, Latest, Outcome};
 const SLICE: Duration = Duration::from_millis(100);
 
 /// Keys followed (relative to the namespace) and what each fills.
-const FOLLOWED: [(&str, Kind); 4] = [
+const FOLLOWED: [(&str, Kind); 5] = [
+    ("world/result/set_object", Kind::Object),
     ("planner/result/plan", Kind::Plan),
     ("motion/result/plan", Kind::Motion),
     ("controller/state", Kind::Controller),
@@ -40,6 +42,7 @@ enum Kind {
     Motion,
     Controller,
     Vision,
+    Object,
 }
 
 /// A reply or an error reply, as published on a result key.
@@ -72,6 +75,9 @@ fn store(kind: Kind, bytes: &[u8], latest: &mut Latest) -> bool {
         Kind::Vision => serde_json::from_slice(bytes)
             .ok()
             .map(|p| latest.vision = Some(Arc::new(p))),
+        Kind::Object => serde_json::from_slice(bytes)
+            .ok()
+            .map(|o| latest.object = Some(Arc::new(o))),
     }
     .is_some()
 }
@@ -118,6 +124,7 @@ fn merge(kind: Kind, parsed: Latest, latest: &mut Latest) {
         }
         Kind::Controller => latest.controller = parsed.controller,
         Kind::Vision => latest.vision = parsed.vision,
+        Kind::Object => latest.object = parsed.object,
     }
 }
 

@@ -1,7 +1,7 @@
 //! What the viewer last heard on the bus: one slot per kind, newest wins.
 //!
 //! What: [`Latest`] — the last grasp plan outcome, motion outcome, controller
-//! state and vision pose — behind [`Board`], which also counts changes
+//! state, vision pose and object summary — behind [`Board`], which also counts changes
 //! (the *generation*) so the web page's event streams know when to send.
 //!
 //! Why: the viewer must never slow the planners down nor grow with the
@@ -24,7 +24,7 @@ use std::time::{Duration, Instant};
 
 use tsukami_msgs::controller::ControllerState;
 use tsukami_msgs::motion::MotionPlanReply;
-use tsukami_msgs::planner::PlanReply;
+use tsukami_msgs::planner::{ObjectSummary, PlanReply};
 use tsukami_msgs::vision::ObjectPose;
 
 /// A result or why there is none.
@@ -47,6 +47,8 @@ pub struct Latest {
     pub controller: Option<Arc<ControllerState>>,
     /// The vision component's last published pose.
     pub vision: Option<Arc<ObjectPose>>,
+    /// The last accepted `set_object`'s summary (its OCP boxes).
+    pub object: Option<Arc<ObjectSummary>>,
     /// Plan outcomes received so far.
     pub plans: u64,
     /// Motion outcomes received so far.

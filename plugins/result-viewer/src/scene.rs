@@ -165,7 +165,7 @@ fn planned(robot: &Robot, latest: &Latest) -> (Option<Vec<f64>>, Value, Value) {
     }
 }
 
-/// What changes with every result: `{generation, world_version, posture:
+/// What changes with every result: `{generation, ocp, world_version, posture:
 /// {source, links} | null, contacts, plan, motion, controller, vision,
 /// counts}`.
 pub fn state(world: &Snapshot<ViewerWorld>, latest: &Latest, generation: u64) -> Value {
@@ -204,6 +204,7 @@ pub fn state(world: &Snapshot<ViewerWorld>, latest: &Latest, generation: u64) ->
     });
     json!({
         "generation": generation,
+        "ocp": ocp_boxes(latest),
         "world_version": world.version,
         "posture": posture,
         "contacts": contacts,
@@ -213,6 +214,24 @@ pub fn state(world: &Snapshot<ViewerWorld>, latest: &Latest, generation: u64) ->
         "vision": vision,
         "counts": {"plans": latest.plans, "motions": latest.motions, "unreadable": latest.unreadable},
     })
+}
+
+/// The object's OCP boxes (`{region, pose, extents, chosen}`, world frame),
+/// `chosen` for the region the last plan grasped.
+fn ocp_boxes(latest: &Latest) -> Value {
+    let chosen = match latest.plan.as_deref() {
+        Some(Outcome::Done(r)) => Some(r.ocp_region),
+        _ => None,
+    };
+    let boxes = latest.object.as_deref().map_or(&[][..], |o| &o.regions[..]);
+    boxes
+        .iter()
+        .map(|b| {
+            let (p, q) = (b.pose.position, b.pose.quaternion);
+            let pose = [p[0], p[1], p[2], q[0], q[1], q[2], q[3]];
+            json!({"region": b.region, "pose": pose, "extents": b.extents, "chosen": Some(b.region) == chosen})
+        })
+        .collect()
 }
 
 /// Link poses along `trajectory` (at most [`MAX_FRAMES`], evenly by point):
