@@ -9,7 +9,7 @@ use nalgebra::{Point3, Vector3};
 use tsukami_msgs::planner::PlanReply;
 use tsukami_result_viewer::drawing::Drawing;
 use tsukami_result_viewer::glb::to_glb;
-use tsukami_result_viewer::grasp_view::{contact_marks, posture, GraspView};
+use tsukami_result_viewer::grasp_view::{self, contact_marks, posture, GraspView};
 use tsukami_result_viewer::render::{render, Camera};
 use tsukami_scenes::World;
 
@@ -40,33 +40,8 @@ pub fn scene_drawing(world: &World, reply: Option<&PlanReply>) -> Result<Drawing
 /// What the camera looks at: midway between the object's box centre and the
 /// contacts' centroid (the object's box centre without a grasp).
 fn look_at(world: &World, reply: Option<&PlanReply>) -> Point3<f64> {
-    let points = &world.object.mesh.vertices;
-    let (lo, hi) = points.iter().fold(
-        (
-            Point3::from([f64::INFINITY; 3]),
-            Point3::from([f64::NEG_INFINITY; 3]),
-        ),
-        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
-    );
-    let center = world.object.pose * nalgebra::center(&lo, &hi);
-    let contacts: Vec<Point3<f64>> = reply
-        .map(|r| {
-            r.contacts
-                .iter()
-                .map(|c| Point3::from(c.position))
-                .collect()
-        })
-        .unwrap_or_default();
-    if contacts.is_empty() || !center.coords.iter().all(|c| c.is_finite()) {
-        return if center.coords.iter().all(|c| c.is_finite()) {
-            center
-        } else {
-            Point3::from(world.object.pose.translation.vector)
-        };
-    }
-    let centroid =
-        contacts.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / contacts.len() as f64;
-    Point3::from((center.coords + centroid) / 2.0)
+    let contacts = reply.map(contact_marks).unwrap_or_default();
+    grasp_view::look_at(&world.object.mesh, &world.object.pose, &contacts)
 }
 
 /// Draws `world` (and `reply`) to a `size` PNG at `png` seen from `eye`
