@@ -29,6 +29,7 @@
 pub mod capsule_mesh;
 pub mod collada;
 pub mod collision;
+pub mod compose;
 pub mod convert;
 pub mod error;
 pub mod files;
@@ -44,6 +45,7 @@ pub mod packages;
 pub mod scene;
 pub mod shape_spec;
 pub mod urdf;
+pub mod urdf_write;
 pub mod urdf_xml;
 
 pub use error::{BodyError, LoadWarning, Result, WarningKind};
