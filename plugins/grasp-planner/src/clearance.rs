@@ -14,9 +14,12 @@
 //! little higher — the contacts move up its sides, which still close (the
 //! exact test decides) — is what a person does with a plate or a lying can.
 //!
-//! How: only obstacle contacts trigger a lift (self-collision and the object
-//! are not helped by it); a lift whose IK fails is skipped. The unlifted pose
-//! is tried first, so a scene whose nominal is already clear is unchanged.
+//! How: only obstacle contacts trigger a lift; an arm against the robot
+//! itself (the upper arm in the chest) or against the object triggers the IK
+//! again from other arm postures ([`ARM_STARTS`]), which a lift would not
+//! change. A lift whose IK fails is skipped. The unlifted pose and the usual
+//! IK start are tried first, so a scene whose nominal is already clear is
+//! unchanged.
 //!
 //! ```
 //! use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
@@ -73,6 +76,78 @@ pub struct Surroundings<'a> {
     pub env: &'a [&'a CollisionObject],
 }
 
+/// How a posture stands against its surroundings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Verdict {
+    /// Nothing touched that may not be.
+    Clear,
+    /// A link touches an obstacle (a lift may help).
+    Obstacle,
+    /// The arm touches the robot itself, or a link the object (another arm
+    /// posture may help).
+    Other,
+}
+
+fn verdict(hand: &HandModel, links: &LinkSets, fk: &FkState, around: &Surroundings<'_>) -> Verdict {
+    match links.blocked(hand, fk, around.object, around.env, true) {
+        None => Verdict::Clear,
+        Some(_) if links.touches_obstacle(hand, fk, around.env) => Verdict::Obstacle,
+        Some(_) => Verdict::Other,
+    }
+}
+
+/// The arm's other starts: every arm joint that is not a wrist joint at
+/// these fractions of its range, tried in turn when the first IK solution
+/// puts the arm against the robot itself.
+pub const ARM_STARTS: [f64; 2] = [0.3, 0.7];
+
+/// The IK solution of `palm` and its verdict: from `q0` first, then (if the
+/// arm touches the robot or the object) from the [`ARM_STARTS`]; the first
+/// clear one, else the first one. `None` when `q0` gives no IK solution.
+fn solve(
+    ik: &mut IkSolver,
+    hand: &HandModel,
+    links: &LinkSets,
+    palm: &Isometry3<f64>,
+    (q0, q_init): (&[f64], &[f64]),
+    around: &Surroundings<'_>,
+    fk: &mut FkState,
+) -> Option<(Vec<f64>, Verdict)> {
+    let mut first: Option<(Vec<f64>, Verdict)> = None;
+    for start in std::iter::once(None).chain(ARM_STARTS.iter().map(Some)) {
+        let mut q_start = q0.to_vec();
+        if let Some(&f) = start {
+            for &j in hand.arm.iter().filter(|j| !hand.wrist.contains(j)) {
+                let l = &hand.robot.joints[j].limits;
+                q_start[j] = l.lower + f * (l.upper - l.lower);
+            }
+        }
+        let rest = if start.is_some() {
+            &q_start[..]
+        } else {
+            q_init
+        };
+        let sol = ik.solve(palm, true, &q_start, Some(rest));
+        if !sol.ok {
+            if start.is_none() {
+                return None; // no nominal here, as in the paper
+            }
+            continue;
+        }
+        hand.robot.forward_kinematics(&sol.q, fk);
+        let v = verdict(hand, links, fk, around);
+        if v == Verdict::Clear {
+            return Some((sol.q, v));
+        }
+        let other = v == Verdict::Other;
+        first.get_or_insert((sol.q, v));
+        if !other {
+            break;
+        }
+    }
+    first
+}
+
 /// The nominal `palm`, lifted as little as [`LIFT_STEP`] steps up to `lift`
 /// allow so that `links` clear `around` (see the module docs); `None` when
 /// the unlifted pose has no IK solution. `q0` holds the grasp type's posture.
@@ -95,31 +170,26 @@ pub fn clear_nominal(
             Translation3::from(palm.translation.vector + up),
             palm.rotation,
         );
-        let sol = ik.solve(&p, true, q0, Some(q_init));
-        if !sol.ok {
+        let Some((q, v)) = solve(ik, hand, links, &p, (q0, q_init), around, fk) else {
             if k == 0 {
                 return None;
             }
             continue;
-        }
-        hand.robot.forward_kinematics(&sol.q, fk);
-        let blocked = links
-            .blocked(hand, fk, around.object, around.env, true)
-            .is_some();
+        };
+        let blocked = v != Verdict::Clear;
         if !blocked {
             return Some(Cleared {
                 palm: p,
-                q: sol.q,
+                q,
                 blocked,
             });
         }
-        let on_obstacle = links.touches_obstacle(hand, fk, around.env);
         first.get_or_insert(Cleared {
             palm: p,
-            q: sol.q,
+            q,
             blocked,
         });
-        if !on_obstacle {
+        if v == Verdict::Other {
             break;
         }
     }
