@@ -870,3 +870,16 @@ pub struct Placement {
     parts: Vec<Vec<Placed>>,
     bounds: Vec<Aabb>,
 }
+
+impl Placement {
+    /// The world axis-aligned box of a placed link's parts, as (min, max)
+    /// corners (min > max when the link has no part or was never placed).
+    pub fn link_bounds(&self, link: LinkId) -> (Point3<f64>, Point3<f64>) {
+        let b = self
+            .bounds
+            .get(link)
+            .copied()
+            .unwrap_or_else(Aabb::new_invalid);
+        (to_point(b.mins), to_point(b.maxs))
+    }
+}

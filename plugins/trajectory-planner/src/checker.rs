@@ -34,6 +34,7 @@ use tsukami_body::collision::{CollisionObject, Placement, RobotCollision};
 use tsukami_body::kinematics::FkState;
 use tsukami_body::model::{JointId, LinkId, RobotModel};
 
+use crate::bodies::Bodies;
 use crate::resolution::SweepBound;
 use crate::rrt_connect::{SegmentSteps, Validity};
 
@@ -47,15 +48,16 @@ pub struct RobotWorld<'a> {
     collision: &'a RobotCollision,
     /// The link pairs checked for self-collision at the first check.
     all_pairs: Vec<(LinkId, LinkId)>,
-    /// Those whose links the planned joints move relative to each other: every
-    /// check after the first.
-    moving_pairs: Vec<(LinkId, LinkId)>,
+    /// The rigid bodies the planned joints move: every check after the first.
+    bodies: Bodies,
     obstacles: Vec<&'a CollisionObject>,
     links: Vec<LinkId>,
     /// Links with geometry that the planned joints move.
     moving: Vec<LinkId>,
     /// The links' parts at the configuration checked last.
     placement: Placement,
+    /// Scratch: the moving links near an obstacle.
+    near: Vec<LinkId>,
     joints: Vec<JointId>,
     base: Vec<f64>,
     margin: f64,
@@ -135,27 +137,17 @@ impl<'a> RobotWorld<'a> {
         let links: Vec<LinkId> = (0..model.links.len())
             .filter(|&l| !collision.link_parts(l).is_empty())
             .collect();
-        let moved = moving_bodies(model, &joints);
-        let moving = links
-            .iter()
-            .copied()
-            .filter(|&l| moved[l].is_some())
-            .collect();
-        let all_pairs = collision.self_pairs();
-        let moving_pairs = all_pairs
-            .iter()
-            .copied()
-            .filter(|&(a, b)| moved[a] != moved[b])
-            .collect();
+        let bodies = Bodies::new(model, collision, &links, &joints);
         RobotWorld {
             model,
             collision,
-            all_pairs,
-            moving_pairs,
+            all_pairs: collision.self_pairs(),
+            moving: bodies.moving_links(),
+            bodies,
             placement: Placement::default(),
+            near: Vec::new(),
             obstacles,
             links,
-            moving,
             joints,
             scratch: base.clone(),
             base,
@@ -272,22 +264,31 @@ impl RobotWorld<'_> {
         let name = |l: LinkId| self.model.links[l].name.clone();
         // Links the planned joints do not move stay where the first check saw them.
         let first = self.checks == 1;
-        let (pairs, links) = if first {
-            (&self.all_pairs, &self.links)
-        } else {
-            (&self.moving_pairs, &self.moving)
-        };
-        self.collision.place(&self.fk, links, &mut self.placement);
-        if let Some((a, b)) =
+        let self_hit = if first {
             self.collision
-                .placed_self_collision(&self.placement, pairs, self.margin)
-        {
+                .place(&self.fk, &self.links, &mut self.placement);
+            self.collision
+                .placed_self_collision(&self.placement, &self.all_pairs, self.margin)
+        } else {
+            self.collision
+                .place(&self.fk, &self.moving, &mut self.placement);
+            self.bodies.update(&self.placement);
+            self.bodies
+                .first_self_collision(self.collision, &self.placement, self.margin)
+        };
+        if let Some((a, b)) = self_hit {
             return Some(Collision {
                 link: name(a),
                 with: format!("link `{}`", name(b)),
             });
         }
         for body in &self.obstacles {
+            let links = if first {
+                &self.links
+            } else {
+                self.bodies.near(body, self.margin, &mut self.near);
+                &self.near
+            };
             if let Some(hit) =
                 self.collision
                     .placed_collision(&self.placement, links, &[*body], self.margin)
@@ -352,28 +353,6 @@ impl Validity for RobotWorld<'_> {
     fn is_valid(&mut self, q: &[f64]) -> bool {
         self.first_hit(q).is_none()
     }
-}
-
-/// Per link: the last joint on its path from the root that a planned joint
-/// drives (the joint itself, or a mimic of it), if any. Links with the same
-/// value move as one rigid body: their relative pose never changes.
-fn moving_bodies(model: &RobotModel, joints: &[JointId]) -> Vec<Option<JointId>> {
-    let mut body = vec![None; model.links.len()];
-    // Links are stored parents first: a link moves with its parent unless its
-    // own joint is planned or mimics a planned joint.
-    for l in 1..model.links.len() {
-        let Some(j) = model.links[l].parent_joint else {
-            continue;
-        };
-        let joint = &model.joints[j];
-        let driven = joints.contains(&j)
-            || joint
-                .mimic
-                .as_ref()
-                .is_some_and(|m| joints.contains(&m.master));
-        body[l] = if driven { Some(j) } else { body[joint.parent] };
-    }
-    body
 }
 
 /// The segment resolution of a [`RobotWorld`], as a value of its own so that a

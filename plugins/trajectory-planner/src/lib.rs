@@ -10,7 +10,8 @@
 //! - [`resolution`]: how finely a straight joint-space segment must be checked so
 //!   that no point of any link moves more than a stated distance between checks;
 //! - [`checker`]: a robot among obstacles, the object and a carried object, as the
-//!   trees' collision test;
+//!   trees' collision test; [`bodies`]: its broad phase (the rigid bodies the
+//!   planned joints move);
 //! - [`cartesian`]: straight palm lines (approach, lift) by IK continuation;
 //! - [`timing`]: time scaling of a piecewise-linear path within every joint's
 //!   velocity limit and an acceleration limit; [`assemble`]: phases into one
@@ -20,6 +21,7 @@
 //!   with the grasp planners; [`error`]: failures and their codes.
 
 pub mod assemble;
+pub mod bodies;
 pub mod cartesian;
 pub mod checker;
 pub mod error;
