@@ -143,6 +143,12 @@ fn connection(
             "text/plain",
             b"too many connections\n",
         );
+        // Read what already came (never waiting: this is the accept thread), so
+        // closing does not reset the connection under the answer.
+        let _ = stream.shutdown(std::net::Shutdown::Write);
+        if stream.set_nonblocking(true).is_ok() {
+            let _ = io::copy(&mut (&stream).take(MAX_HEAD as u64), &mut io::sink());
+        }
         return;
     }
     let slot = Slot(active.clone());
