@@ -11,7 +11,14 @@ const view = { generation: -1, worldVersion: -1, plans: 0, motions: 0, shown: -1
 window.tsukamiViewer = view;
 
 const container = document.getElementById('view');
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+let renderer;
+try {
+  renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+} catch (e) {
+  view.error = `no WebGL in this browser: ${e}`;
+  document.getElementById('info').textContent = view.error;
+  throw e;
+}
 renderer.setPixelRatio(window.devicePixelRatio);
 renderer.setSize(window.innerWidth, window.innerHeight);
 container.appendChild(renderer.domElement);

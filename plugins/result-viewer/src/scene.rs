@@ -146,7 +146,8 @@ fn plan_panel(reply: &PlanReply) -> Value {
     })
 }
 
-/// The robot's pose data for the plan: `(posture, contacts, panel, note)`.
+/// The plan's part of the state: `(posture, contacts, panel)`; no posture
+/// without a plan that fits this robot.
 fn planned(robot: &Robot, latest: &Latest) -> (Option<Vec<f64>>, Value, Value) {
     match latest.plan.as_deref() {
         Some(Outcome::Done(reply)) => {
