@@ -254,3 +254,51 @@ fn hand_links_against_a_can() {
     // Normal on the can's side points back toward the finger (-palm z).
     assert!(p.normal.dot(&(palm.rotation * -Vector3::z())) > 0.95);
 }
+
+/// The AABB broad phase of the pair queries (link boxes, then part boxes,
+/// placed once per configuration) skips only pairs that cannot collide: the
+/// same pairs come out as from each pair's distance, which uses no box.
+#[test]
+fn broad_phase_drops_no_colliding_pair() {
+    let m = common::humanoid();
+    let c = RobotCollision::new(&m).unwrap();
+    let mut fk = FkState::new(&m);
+    let mut rng = common::rng(11);
+    let margin = 0.005;
+    let links: Vec<usize> = (0..m.links.len())
+        .filter(|&l| !c.link_parts(l).is_empty())
+        .collect();
+    let table = object(
+        Geometry::Box {
+            size: Vector3::new(0.4, 0.6, 0.9),
+        },
+        Isometry3::translation(0.45, -0.2, 0.45),
+    );
+    let (mut pairs, mut hits) = (0, 0);
+    for _ in 0..60 {
+        m.forward_kinematics(&common::random_q(&m, &mut rng), &mut fk);
+        let mut expected = Vec::new();
+        for (i, &a) in links.iter().enumerate() {
+            let body = CollisionObject::new("a", *fk.pose(a), c.link_parts(a).to_vec());
+            for &b in &links[i + 1..] {
+                if !c.is_allowed(a, b) && c.link_object_proximity(&fk, b, &body, margin).is_some() {
+                    expected.push((a, b));
+                }
+            }
+        }
+        assert_eq!(c.self_collisions(&fk, margin), expected);
+        pairs += expected.len();
+        for &l in &links {
+            let near = c.link_object_proximity(&fk, l, &table, margin).is_some();
+            assert_eq!(
+                c.first_collision(&fk, &[l], &[&table], margin).is_some(),
+                near
+            );
+            hits += usize::from(near);
+        }
+    }
+    assert!(
+        pairs > 10 && hits > 10,
+        "{pairs} self pairs, {hits} table hits"
+    );
+}
