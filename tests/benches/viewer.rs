@@ -19,6 +19,7 @@ use tsukami_scenes::paper_scene;
 
 const PLANS: u64 = 300;
 const WARM_UP: u64 = 20;
+const CHANGES: usize = 40;
 const T: Duration = Duration::from_secs(60);
 
 /// A bus with `can_breast` set up and planned once.
@@ -107,6 +108,32 @@ fn main() {
     println!(
         "  the viewer followed {} plans, sent {} events to {} pages",
         state["counts"]["plans"], state["web"]["events_sent"], state["web"]["event_clients"]
+    );
+
+    // World changes go to every world-aware plugin: the viewer loads the object too.
+    let scene =
+        tsukami_scenes::scene_requests(&models_dir().join("scenes/can_breast.toml")).unwrap();
+    let object = serde_json::to_vec(&scene.object).unwrap();
+    let set_object = |bus: &TestBus| {
+        let start = Instant::now();
+        bus.client
+            .command(ROLE_GRASP_PLANNER, "set_object", &object, T)
+            .expect("set_object");
+        start.elapsed()
+    };
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for _ in 0..CHANGES {
+        a.push(set_object(&without));
+        b.push(set_object(&with));
+    }
+    a.sort();
+    b.sort();
+    println!("set_object round trip (can_350ml), {CHANGES} times, interleaved:");
+    println!("  {:<44} p50 {:>7.2} ms", "without the viewer", ms(&a, 0.5));
+    println!("  {:<44} p50 {:>7.2} ms", "with the viewer", ms(&b, 0.5));
+    println!(
+        "  ratio with / without: p50 {:.3}x",
+        ms(&b, 0.5) / ms(&a, 0.5)
     );
     drop(with);
     drop(without);
