@@ -8,8 +8,8 @@
 //! and an open shelf with a board above.
 //!
 //! Used by `examples/object_bench.rs` (every case, figures in
-//! `docs/benchmarks.md`) and `tests/object_subset.rs` (a fixed subset, checked
-//! in every test run). Included with `#[path]`; not every user calls every item.
+//! `docs/benchmarks.md`) and the workspace's `tests/tests/object_subset.rs` (a
+//! fixed subset over the bus, checked in every test run). Included with `#[path]`; not every user calls every item.
 #![allow(dead_code)]
 
 use std::f64::consts::FRAC_PI_2;
