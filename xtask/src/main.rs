@@ -5,6 +5,12 @@
 //! `tsukami-controller`), which `cargo run -p tsukami` alone would not build — then
 //! runs `target/release/tsukami demo [ARGS]`, which finds the components beside
 //! itself.
+//!
+//! `cargo benchmarks [--only NAME,…] [--list]`: runs the bench targets and
+//! writes their output and the machine's description into `docs/benchmarks.md`
+//! ([`benchmarks`]).
+
+mod benchmarks;
 
 use std::process::{Command, ExitCode};
 
@@ -15,8 +21,9 @@ fn main() -> ExitCode {
     match task.as_str() {
         "demo" => run_release("demo", &rest),
         "host" => run_release("run", &rest),
+        "benchmarks" => run_benchmarks(&rest),
         _ => {
-            eprintln!("usage: cargo demo [ARGS] | cargo host [ARGS]");
+            eprintln!("usage: cargo demo [ARGS] | cargo host [ARGS] | cargo benchmarks [--only A,B] [--list]");
             ExitCode::from(2)
         }
     }
@@ -43,6 +50,31 @@ fn run_release(subcommand: &str, rest: &[String]) -> ExitCode {
         Ok(status) => ExitCode::from(u8::try_from(status.code().unwrap_or(1)).unwrap_or(1)),
         Err(e) => {
             eprintln!("could not run {}: {e}", exe.display());
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run_benchmarks(rest: &[String]) -> ExitCode {
+    if rest.iter().any(|a| a == "--list") {
+        for b in benchmarks::BENCHES {
+            println!("{:<14} cargo {}", b.name, b.args.join(" "));
+        }
+        return ExitCode::SUCCESS;
+    }
+    let only: Vec<String> = match rest {
+        [] => Vec::new(),
+        [flag, names] if flag == "--only" => names.split(',').map(str::to_owned).collect(),
+        _ => {
+            eprintln!("usage: cargo benchmarks [--only NAME,NAME] [--list]");
+            return ExitCode::from(2);
+        }
+    };
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    match benchmarks::run(&root, &only) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("cargo benchmarks: {e}");
             ExitCode::FAILURE
         }
     }
