@@ -684,9 +684,13 @@ impl RobotCollision {
         objects: &[&CollisionObject],
         margin: f64,
     ) -> Option<Hit> {
-        let mut placement = Placement::default();
-        self.place(fk, links, &mut placement);
-        self.placed_collision(&placement, links, objects, margin)
+        let mut placed = Vec::new();
+        links.iter().find_map(|&link| {
+            let pose = to_pose(fk.pose(link));
+            placed.clear();
+            placed.extend(self.parts[link].iter().map(|p| Placed::new(&pose, p)));
+            self.link_hit(link, &placed, &union(&placed), objects, margin)
+        })
     }
 
     /// How deep `link` sinks into `object` (0 when apart or only touching):
@@ -801,13 +805,15 @@ impl RobotCollision {
         b: LinkId,
         margin: f64,
     ) -> bool {
-        if !overlap(&placement.bounds[a], &placement.bounds[b], margin) {
+        let (Some((pa, ba)), Some((pb, bb))) = (placement.link(a), placement.link(b)) else {
+            return false; // not placed
+        };
+        if !overlap(ba, bb, margin) {
             return false;
         }
-        let (pa, pb) = (&placement.parts[a], &placement.parts[b]);
-        self.parts[a].iter().zip(pa).any(|(x, xa)| {
-            self.parts[b]
-                .iter()
+        let (xs, ys) = (self.link_parts(a), self.link_parts(b));
+        xs.iter().zip(pa).any(|(x, xa)| {
+            ys.iter()
                 .zip(pb)
                 .any(|(y, yb)| placed_collides(self.method, xa, x, yb, y, margin))
         })
@@ -815,7 +821,7 @@ impl RobotCollision {
 
     /// [`Self::first_self_collision`] over the placed links: the first of
     /// `pairs` (e.g. a subset of [`Self::self_pairs`]) whose links come
-    /// closer than `margin`. Every link of `pairs` must be placed.
+    /// closer than `margin`. Links never placed collide with nothing.
     pub fn placed_self_collision(
         &self,
         placement: &Placement,
@@ -829,7 +835,8 @@ impl RobotCollision {
     }
 
     /// [`Self::first_collision`] over the placed links: the first of `links`
-    /// (each placed) that comes closer than `margin` to one of `objects`.
+    /// that comes closer than `margin` to one of `objects` (links never placed
+    /// collide with nothing).
     pub fn placed_collision(
         &self,
         placement: &Placement,
@@ -837,27 +844,33 @@ impl RobotCollision {
         objects: &[&CollisionObject],
         margin: f64,
     ) -> Option<Hit> {
-        for &link in links {
-            let bounds = &placement.bounds[link];
-            for (o, object) in objects.iter().enumerate() {
-                if !overlap(bounds, &object.bounds, margin) {
-                    continue;
-                }
-                let hit =
-                    self.parts[link]
+        links.iter().find_map(|&link| {
+            let (placed, bounds) = placement.link(link)?;
+            self.link_hit(link, placed, bounds, objects, margin)
+        })
+    }
+
+    /// The first of `objects` that `link`, its parts placed as `placed` within
+    /// `bounds`, comes closer than `margin` to.
+    fn link_hit(
+        &self,
+        link: LinkId,
+        placed: &[Placed],
+        bounds: &Aabb,
+        objects: &[&CollisionObject],
+        margin: f64,
+    ) -> Option<Hit> {
+        let o = objects.iter().position(|object| {
+            overlap(bounds, &object.bounds, margin)
+                && self.link_parts(link).iter().zip(placed).any(|(lp, la)| {
+                    object
+                        .parts
                         .iter()
-                        .zip(&placement.parts[link])
-                        .any(|(lp, la)| {
-                            object.parts.iter().zip(&object.placed).any(|(op, oa)| {
-                                placed_collides(self.method, la, lp, oa, op, margin)
-                            })
-                        });
-                if hit {
-                    return Some(Hit { link, object: o });
-                }
-            }
-        }
-        None
+                        .zip(&object.placed)
+                        .any(|(op, oa)| placed_collides(self.method, la, lp, oa, op, margin))
+                })
+        })?;
+        Some(Hit { link, object: o })
     }
 }
 
@@ -872,6 +885,11 @@ pub struct Placement {
 }
 
 impl Placement {
+    /// A placed link's parts and box.
+    fn link(&self, link: LinkId) -> Option<(&[Placed], &Aabb)> {
+        Some((self.parts.get(link)?, self.bounds.get(link)?))
+    }
+
     /// The world axis-aligned box of a placed link's parts, as (min, max)
     /// corners (min > max when the link has no part or was never placed).
     pub fn link_bounds(&self, link: LinkId) -> (Point3<f64>, Point3<f64>) {
