@@ -8,16 +8,21 @@
 //! measures.
 //!
 //! How: back-project every `stride`-th pixel, remove the large horizontal
-//! planes (RANSAC), cluster the rest on the pixel grid (and split each cluster
-//! again with a smaller gap, since an occluder close in front of the target
-//! joins it), add the unions of two clusters that together are no larger than
-//! the object (an occluder in front can cut the target in two), keep pieces no
-//! larger than the object; for each, try every principal-axis hypothesis and
-//! every resting pose on the plane under it ([`crate::resting`]) with a short
-//! coarse ICP, refine the best few with a full ICP, then gather the
-//! full-resolution points around the fitted model and refine once more; the
-//! candidate with the highest verified confidence wins, reported in its
-//! symmetry class's canonical form.
+//! planes (RANSAC), cut the rest into object-sized segments
+//! ([`crate::segment`]: clusters, their pieces at a smaller gap, unions of two;
+//! no wider than the model). For each segment, start ICP from every
+//! principal-axis hypothesis ([`crate::hypotheses`]) and every resting pose
+//! of the model on the plane under it ([`crate::resting`]) with a short
+//! coarse ICP (nearest samples by the template's lookup grid), and rank each
+//! fit by a quick verification against the image: the fraction of the
+//! segment it explains times the agreement of its visible surface with the
+//! measured depths (free space seen through counts against it), halved when
+//! it does not rest on the plane. The best few fits of every segment, best
+//! ranked first, get a full ICP, a last ICP with exact pairing on the
+//! full-resolution points gathered around the model, and a refinement by
+//! visible-surface agreement ([`crate::freespace`]) for the directions the
+//! points leave free; then the full verification. The candidate with the
+//! highest confidence wins, reported in its symmetry class's canonical form.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -28,13 +33,14 @@ use tsukami_body::files::ModelRoots;
 
 use crate::camera::Camera;
 use crate::cloud::{Moments, PointCloud};
-use crate::cluster;
 use crate::depth::DepthImage;
 use crate::error::{invalid, Result};
+use crate::freespace::{settle, SettleParams};
 use crate::hypotheses::from_principal_axes;
 use crate::icp::{refine, IcpFit, IcpParams};
 use crate::plane::{find_planes, FoundPlane, PlaneParams};
 use crate::resting::on_plane;
+use crate::segment::{segments, Grid, Segment, SegmentParams};
 use crate::template::ObjectTemplate;
 use crate::verify::{verify, Verdict, VerifyParams};
 
@@ -45,39 +51,35 @@ pub struct DetectParams {
     pub stride: u32,
     /// Plane removal.
     pub plane: PlaneParams,
-    /// Largest 3-D gap inside a cluster (m).
-    pub cluster_gap: f64,
-    /// Each cluster is split again with these fractions of `cluster_gap`,
-    /// each split's pieces candidates of their own.
-    pub split_gaps: Vec<f64>,
-    /// Smallest cluster (points of the strided cloud).
-    pub min_cluster_points: usize,
-    /// Most clusters examined (largest first).
-    pub max_clusters: usize,
+    /// Clustering and object-sized segments.
+    pub segment: SegmentParams,
     /// Coarse ICP per hypothesis.
     pub coarse: IcpParams,
     /// Points used by the coarse ICP.
     pub coarse_points: usize,
-    /// Hypotheses per cluster refined fully.
+    /// Quick verification ranking the coarse fits.
+    pub rank: VerifyParams,
+    /// Coarse fits per segment kept for the full ICP.
     pub refine_top: usize,
     /// Full ICP.
     pub fine: IcpParams,
     /// Points used by the full ICP.
     pub fine_points: usize,
+    /// Iterations of the last ICP, on the gathered full-resolution points
+    /// with exact pairing.
+    pub exact_iterations: usize,
     /// Full-resolution points farther than this from the fitted model are not gathered (m).
     pub gather: f64,
+    /// Refinement by visible-surface agreement after the last ICP (none: off).
+    pub settle: Option<SettleParams>,
     /// Verification.
     pub verify: VerifyParams,
-    /// Fine fits examined (best coarse scores first).
+    /// Fine fits examined (best ranked coarse fits first).
     pub max_fine: usize,
     /// Stop examining fine fits once one reaches this confidence.
     pub early_accept: f64,
     /// Also start from the model's resting poses on the plane under a segment.
     pub resting_hypotheses: bool,
-    /// ... only for a segment whose best principal-axis coarse score is below this.
-    pub resting_below: f64,
-    /// Also try the union of two clusters no larger than the object together.
-    pub merge_pairs: bool,
     /// Report only poses resting on a found plane (within the two limits below).
     pub require_support: bool,
     /// Deepest a model may sink into the plane under it (m).
@@ -95,32 +97,43 @@ impl Default for DetectParams {
         DetectParams {
             stride: 2,
             plane: PlaneParams::default(),
-            cluster_gap: 0.012,
-            split_gaps: vec![0.6],
-            min_cluster_points: 25,
-            max_clusters: 6,
+            segment: SegmentParams {
+                cluster_gap: 0.012,
+                split_gaps: vec![0.6],
+                min_points: 25,
+                max_clusters: 6,
+                merge_pairs: true,
+                margin: 0.01,
+            },
             coarse: IcpParams {
                 iterations: 12,
                 gate_start: 0.04,
                 gate_end: 0.01,
+                fast_pairing: true,
                 ..IcpParams::default()
             },
             coarse_points: 250,
+            rank: VerifyParams {
+                sample_step: 8,
+                fast_pairing: true,
+                ..VerifyParams::default()
+            },
             refine_top: 3,
             fine: IcpParams {
                 iterations: 20,
                 gate_start: 0.02,
                 gate_end: 0.005,
+                fast_pairing: true,
                 ..IcpParams::default()
             },
             fine_points: 1200,
+            exact_iterations: 6,
             gather: 0.008,
+            settle: Some(SettleParams::default()),
             verify: VerifyParams::default(),
             max_fine: 4,
             early_accept: 0.9,
             resting_hypotheses: true,
-            resting_below: 0.96,
-            merge_pairs: true,
             require_support: true,
             max_penetration: 0.01,
             max_rest_gap: 0.02,
@@ -226,6 +239,22 @@ struct Candidate {
     verdict: Verdict,
 }
 
+/// What every stage looks at: the model, the image, its planes, the settings.
+struct View<'a> {
+    template: &'a ObjectTemplate,
+    image: &'a DepthImage,
+    camera: &'a Camera,
+    planes: &'a [FoundPlane],
+    params: &'a DetectParams,
+}
+
+/// A coarse fit on a segment and its rank.
+struct Hypothesis {
+    rank: f64,
+    segment: usize,
+    fit: IcpFit,
+}
+
 /// Runs the pipeline for one template.
 pub fn detect_with(
     template: &ObjectTemplate,
@@ -238,22 +267,27 @@ pub fn detect_with(
     let not_found =
         |reason: String, best: Option<Detection>| Ok(Outcome::NotFound(NotFound { reason, best }));
     let cloud = PointCloud::from_depth(image, camera, params.stride);
-    if cloud.len() < params.min_cluster_points {
+    if cloud.len() < params.segment.min_points {
         return not_found("the image has (almost) no depth measurements".into(), None);
     }
     let planes = find_planes(&cloud.points, &params.plane);
-    let size_limit = template.radius * 1.25 + 0.01;
-    let (mut clusters, mut pieces) = segment(&cloud, &planes, image.width(), params);
-    if params.merge_pairs {
-        add_unions(&mut clusters, &mut pieces, size_limit);
-    }
-    let segments = candidate_sets(&pieces, size_limit);
+    let grid = Grid {
+        width: image.width(),
+        stride: params.stride,
+    };
+    let size = 2.0 * template.radius;
+    let (clusters, segments) = segments(&cloud, &planes, grid, size, &params.segment);
     let t_segment = started.elapsed();
-    let coarse = coarse_fits(template, &segments, &planes, &camera.centre(), params);
+    let view = View {
+        template,
+        image,
+        camera,
+        planes: &planes,
+        params,
+    };
+    let coarse = coarse_fits(&view, &segments);
     let t_coarse = started.elapsed();
-    let best = best_fine(
-        template, &segments, &clusters, &coarse, image, camera, &planes, params,
-    );
+    let best = best_fine(&view, &segments, &clusters, &coarse);
     tracing::debug!(
         object = %template.name,
         points = cloud.len(),
@@ -309,72 +343,72 @@ fn explain(v: &Verdict, min_confidence: f64) -> String {
     )
 }
 
-/// Every principal-axis hypothesis on every cluster, after a short coarse
-/// ICP: the best `refine_top` of each cluster, best first, as (score,
-/// cluster index, fit).
-fn coarse_fits(
-    template: &ObjectTemplate,
-    segments: &[&Segment],
-    planes: &[FoundPlane],
-    cam: &Point3<f64>,
-    params: &DetectParams,
-) -> Vec<(f64, usize, IcpFit)> {
-    let mut coarse: Vec<(f64, usize, IcpFit)> = Vec::new();
+/// Every principal-axis hypothesis and every resting pose on every segment,
+/// after a short coarse ICP, ranked by a quick verification: the best
+/// `refine_top` of each segment, best first.
+fn coarse_fits(view: &View, segments: &[Segment]) -> Vec<Hypothesis> {
+    let (template, params) = (view.template, view.params);
+    let cam = view.camera.centre();
+    let mut all: Vec<Hypothesis> = Vec::new();
     for (si, seg) in segments.iter().enumerate() {
         let Some(m) = Moments::of(&seg.points) else {
             continue;
         };
         let pts = thin(&seg.points, params.coarse_points);
-        let fit = |h: Isometry3<f64>| {
-            let f = refine(template, &pts, Some(*cam), h, &params.coarse);
-            (score(&f), si, f)
-        };
-        let mut fits: Vec<(f64, usize, IcpFit)> = from_principal_axes(template, &m, cam)
-            .into_iter()
-            .map(fit)
-            .collect();
-        let best = fits.iter().map(|f| f.0).fold(f64::NEG_INFINITY, f64::max);
-        if params.resting_hypotheses && best < params.resting_below {
-            if let Some(plane) = plane_below(planes, &m.centroid) {
-                fits.extend(
-                    on_plane(template, &seg.points, &plane.plane, cam)
-                        .into_iter()
-                        .map(fit),
-                );
+        let mut starts = from_principal_axes(template, &m, &cam);
+        if params.resting_hypotheses {
+            if let Some(plane) = plane_below(view.planes, &m.centroid) {
+                starts.extend(on_plane(template, &seg.points, &plane.plane, &cam));
             }
         }
-        fits.sort_by(|a, b| b.0.total_cmp(&a.0));
-        coarse.extend(fits.into_iter().take(params.refine_top));
+        let mut fits: Vec<Hypothesis> = starts
+            .into_iter()
+            .map(|start| {
+                let fit = refine(template, &pts, Some(cam), start, &params.coarse);
+                Hypothesis {
+                    rank: rank(view, &fit, &pts),
+                    segment: si,
+                    fit,
+                }
+            })
+            .collect();
+        fits.sort_by(|a, b| b.rank.total_cmp(&a.rank));
+        all.extend(fits.into_iter().take(params.refine_top));
     }
-    coarse.sort_by(|a, b| b.0.total_cmp(&a.0));
-    coarse
+    all.sort_by(|a, b| b.rank.total_cmp(&a.rank));
+    all
+}
+
+/// The rank of a coarse fit: how much of the segment the model explains times
+/// how much of the model's visible surface the image supports (a quick
+/// [`verify`] on a subset of the model's samples), halved when the model does
+/// not rest on the plane under it (coarse limits: twice the final ones).
+fn rank(view: &View, fit: &IcpFit, points: &[Point3<f64>]) -> f64 {
+    let p = &view.params.rank;
+    let v = verify(view.template, &fit.pose, points, view.image, view.camera, p);
+    let resting = rest_gap(view.template, &fit.pose, view.planes).is_some_and(|g| {
+        g >= -2.0 * view.params.max_penetration && g <= 2.0 * view.params.max_rest_gap
+    });
+    let prior = if resting || !view.params.require_support {
+        1.0
+    } else {
+        0.5
+    };
+    v.explained * v.agreement(p.unmeasured_weight) * prior
 }
 
 /// The verified fine fit of highest confidence among the best `max_fine`
 /// coarse fits (stopping early at `early_accept`).
-#[allow(clippy::too_many_arguments)]
 fn best_fine(
-    template: &ObjectTemplate,
-    segments: &[&Segment],
+    view: &View,
+    segments: &[Segment],
     clusters: &[Vec<Point3<f64>>],
-    coarse: &[(f64, usize, IcpFit)],
-    image: &DepthImage,
-    camera: &Camera,
-    planes: &[FoundPlane],
-    params: &DetectParams,
+    coarse: &[Hypothesis],
 ) -> Option<Candidate> {
     let mut best: Option<Candidate> = None;
-    for (_, si, c) in coarse.iter().take(params.max_fine) {
-        let cand = fine_fit(
-            template,
-            &segments[*si].points,
-            &clusters[segments[*si].parent],
-            c.pose,
-            image,
-            camera,
-            planes,
-            params,
-        );
+    for h in coarse.iter().take(view.params.max_fine) {
+        let seg = &segments[h.segment];
+        let cand = fine_fit(view, &seg.points, &clusters[seg.parent], h.fit.pose);
         if best
             .as_ref()
             .is_none_or(|b| cand.verdict.confidence > b.verdict.confidence)
@@ -383,7 +417,7 @@ fn best_fine(
         }
         if best
             .as_ref()
-            .is_some_and(|b| b.verdict.confidence >= params.early_accept)
+            .is_some_and(|b| b.verdict.confidence >= view.params.early_accept)
         {
             break;
         }
@@ -399,155 +433,45 @@ fn plane_below<'a>(planes: &'a [FoundPlane], p: &Point3<f64>) -> Option<&'a Foun
         .min_by(|a, b| a.plane.distance(p).total_cmp(&b.plane.distance(p)))
 }
 
-/// A cluster, or a piece of one, and the index of its whole cluster.
-struct Segment {
-    points: Vec<Point3<f64>>,
-    parent: usize,
-}
-
-/// The off-plane points of the strided cloud, clustered (largest first), and
-/// each cluster's pieces when a smaller gap splits it.
-fn segment(
-    cloud: &PointCloud,
-    planes: &[FoundPlane],
-    width: u32,
-    params: &DetectParams,
-) -> (Vec<Vec<Point3<f64>>>, Vec<Segment>) {
-    let s = params.stride.max(1);
-    let gw = width.div_ceil(s) as usize;
-    let gh = cloud
-        .pixels
-        .iter()
-        .map(|p| p / width / s)
-        .max()
-        .map_or(0, |v| v as usize + 1);
-    let mut in_plane = vec![false; cloud.len()];
-    for p in planes {
-        for &i in &p.inliers {
-            in_plane[i] = true;
-        }
-    }
-    let mut grid = vec![None; gw * gh];
-    for (i, (p, px)) in cloud.points.iter().zip(&cloud.pixels).enumerate() {
-        if !in_plane[i] {
-            let (u, v) = (px % width / s, px / width / s);
-            grid[v as usize * gw + u as usize] = Some(*p);
-        }
-    }
-    let (mut parents, mut out) = (Vec::new(), Vec::new());
-    for (pi, parent) in cluster::clusters(&grid, gw, params.cluster_gap, params.min_cluster_points)
-        .into_iter()
-        .take(params.max_clusters)
-        .enumerate()
-    {
-        // Split again with smaller gaps: an occluder standing close in front
-        // of the target joins it at first.
-        let mut sub = vec![None; grid.len()];
-        for &i in &parent {
-            sub[i] = grid[i];
-        }
-        let points =
-            |c: &[usize]| -> Vec<Point3<f64>> { c.iter().filter_map(|&i| grid[i]).collect() };
-        parents.push(points(&parent));
-        out.push(Segment {
-            points: points(&parent),
-            parent: pi,
-        });
-        for factor in &params.split_gaps {
-            let children = cluster::clusters(
-                &sub,
-                gw,
-                params.cluster_gap * factor,
-                params.min_cluster_points,
-            );
-            if children.len() > 1 {
-                out.extend(children.iter().map(|c| Segment {
-                    points: points(c),
-                    parent: pi,
-                }));
-            }
-        }
-    }
-    (parents, out)
-}
-
-/// Adds, as a cluster and a segment of its own, the union of every two
-/// clusters that together are no larger than the object: an occluder standing
-/// in front of the target can cut what is seen of it in two.
-fn add_unions(clusters: &mut Vec<Vec<Point3<f64>>>, pieces: &mut Vec<Segment>, size_limit: f64) {
-    let n = clusters.len();
-    let centroids: Vec<Option<Point3<f64>>> = clusters
-        .iter()
-        .map(|c| Moments::of(c).map(|m| m.centroid))
-        .collect();
-    for a in 0..n {
-        for b in a + 1..n {
-            let (Some(ca), Some(cb)) = (centroids[a], centroids[b]) else {
-                continue;
-            };
-            if (ca - cb).norm() > 2.0 * size_limit {
-                continue;
-            }
-            let union: Vec<Point3<f64>> = clusters[a].iter().chain(&clusters[b]).copied().collect();
-            if extent(&union) <= size_limit {
-                pieces.push(Segment {
-                    points: union.clone(),
-                    parent: clusters.len(),
-                });
-                clusters.push(union);
-            }
-        }
-    }
-}
-
-/// Largest distance of a point from the centroid (infinite for < 3 points).
-fn extent(points: &[Point3<f64>]) -> f64 {
-    match Moments::of(points) {
-        Some(m) => points
-            .iter()
-            .map(|p| (p - m.centroid).norm())
-            .fold(0.0, f64::max),
-        None => f64::INFINITY,
-    }
-}
-
-/// The object-sized segments.
-fn candidate_sets(segments: &[Segment], size_limit: f64) -> Vec<&Segment> {
-    segments
-        .iter()
-        .filter(|s| extent(&s.points) <= size_limit)
-        .collect()
-}
-
 /// Full ICP from a coarse pose on `seg`, again on the gathered
 /// full-resolution points, then verification against the `whole` cluster
 /// `seg` is a piece of.
-#[allow(clippy::too_many_arguments)]
 fn fine_fit(
-    template: &ObjectTemplate,
+    view: &View,
     seg: &[Point3<f64>],
     whole: &[Point3<f64>],
     start: Isometry3<f64>,
-    image: &DepthImage,
-    camera: &Camera,
-    planes: &[FoundPlane],
-    params: &DetectParams,
 ) -> Candidate {
-    let cam = camera.centre();
+    let (template, params) = (view.template, view.params);
+    let cam = view.camera.centre();
     let fine_pts = thin(seg, params.fine_points);
     let fit = refine(template, &fine_pts, Some(cam), start, &params.fine);
-    let gathered = gather(template, &fit.pose, image, camera, planes, params);
-    let fit = if gathered.len() >= fine_pts.len() / 2 {
-        let pts = thin(&gathered, params.fine_points);
-        let mut last = params.fine.clone();
-        last.gate_start = params.gather;
-        last.iterations = 10;
-        refine(template, &pts, Some(cam), fit.pose, &last)
+    let gathered = gather(view, &fit.pose);
+    let (pts, gate) = if gathered.len() >= fine_pts.len() / 2 {
+        (thin(&gathered, params.fine_points), params.gather)
     } else {
-        fit
+        (fine_pts, params.fine.gate_end)
     };
-    let mut verdict = verify(template, &fit.pose, whole, image, camera, &params.verify);
-    let gap = rest_gap(template, &fit.pose, planes);
+    // The last iterations pair exactly (the k-d tree): the data's accuracy.
+    let last = IcpParams {
+        iterations: params.exact_iterations,
+        gate_start: gate,
+        fast_pairing: false,
+        ..params.fine.clone()
+    };
+    let mut fit = refine(template, &pts, Some(cam), fit.pose, &last);
+    if let Some(settle_params) = &params.settle {
+        fit.pose = settle(template, &fit.pose, view.image, view.camera, settle_params);
+    }
+    let mut verdict = verify(
+        template,
+        &fit.pose,
+        whole,
+        view.image,
+        view.camera,
+        &params.verify,
+    );
+    let gap = rest_gap(template, &fit.pose, view.planes);
     verdict.resting = gap.is_some_and(|g| g >= -params.max_penetration && g <= params.max_rest_gap);
     if params.require_support && !verdict.resting {
         verdict.confidence = 0.0;
@@ -575,11 +499,6 @@ fn rest_gap(
     )
 }
 
-/// Ranking of coarse fits: paired fraction, then small residual.
-fn score(f: &IcpFit) -> f64 {
-    f.fraction() - f.rms.min(1.0) * 20.0
-}
-
 /// At most `n` points, evenly strided.
 fn thin(points: &[Point3<f64>], n: usize) -> Vec<Point3<f64>> {
     let step = points.len().div_ceil(n.max(1)).max(1);
@@ -587,14 +506,8 @@ fn thin(points: &[Point3<f64>], n: usize) -> Vec<Point3<f64>> {
 }
 
 /// Full-resolution points within `gather` of the model at `pose`, off the planes.
-fn gather(
-    template: &ObjectTemplate,
-    pose: &Isometry3<f64>,
-    image: &DepthImage,
-    camera: &Camera,
-    planes: &[FoundPlane],
-    params: &DetectParams,
-) -> Vec<Point3<f64>> {
+fn gather(view: &View, pose: &Isometry3<f64>) -> Vec<Point3<f64>> {
+    let (template, params, camera) = (view.template, view.params, view.camera);
     let k = &camera.intrinsics;
     let c = camera.pose.inverse() * (pose * template.moments.centroid);
     let Some((u, v)) = k.project(&c) else {
@@ -612,15 +525,16 @@ fn gather(
     let gate2 = params.gather * params.gather;
     let centre = pose * template.moments.centroid;
     let reach2 = (template.radius + params.gather).powi(2);
-    PointCloud::from_region(image, camera, region)
+    PointCloud::from_region(view.image, camera, region)
         .points
         .into_iter()
         .filter(|p| {
             (p - centre).norm_squared() <= reach2
-                && planes
+                && view
+                    .planes
                     .iter()
                     .all(|pl| pl.plane.distance(p).abs() > params.plane.threshold)
-                && template.nearest(&(inv * p)).1 <= gate2
+                && template.nearest_fast(&(inv * p)).1 <= gate2
         })
         .collect()
 }

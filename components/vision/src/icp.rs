@@ -66,6 +66,11 @@ pub struct IcpParams {
     pub huber: f64,
     /// Stop when an update moves less than this (m, and rad).
     pub converged: f64,
+    /// Pair through the template's lookup grid ([`crate::lookup`]: faster,
+    /// off by up to a cell) instead of the exact k-d tree search; the grid
+    /// pairs nothing farther than `template::LOOKUP_MARGIN`, so `gate_start`
+    /// should not exceed it.
+    pub fast_pairing: bool,
 }
 
 impl Default for IcpParams {
@@ -77,6 +82,7 @@ impl Default for IcpParams {
             gate_end: 0.006,
             huber: 0.002,
             converged: 1e-5,
+            fast_pairing: false,
         }
     }
 }
@@ -137,8 +143,7 @@ pub fn refine(
             template,
             points,
             camera.map(|c| inv * c),
-            &inv,
-            gate,
+            (&inv, gate, params.fast_pairing),
             &mut pairs,
         );
         fit.iterations = it + 1;
@@ -163,8 +168,7 @@ pub fn refine(
         template,
         points,
         camera.map(|c| inv * c),
-        &inv,
-        params.gate_end,
+        (&inv, params.gate_end, params.fast_pairing),
         &mut pairs,
     );
     fit.paired = pairs.len();
@@ -182,15 +186,14 @@ fn collect_pairs(
     template: &ObjectTemplate,
     points: &[Point3<f64>],
     camera_obj: Option<Point3<f64>>,
-    inv: &Isometry3<f64>,
-    gate: f64,
+    (inv, gate, fast): (&Isometry3<f64>, f64, bool),
     pairs: &mut Vec<Pair>,
 ) {
     pairs.clear();
     let gate2 = gate * gate;
     for p in points {
         let x = inv * p;
-        let (j, d2) = template.nearest(&x);
+        let (j, d2) = template.pair(&x, fast);
         if d2 > gate2 {
             continue;
         }

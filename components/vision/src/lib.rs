@@ -4,13 +4,17 @@
 //! image, and a depth-camera simulator for the robot's head camera.
 //!
 //! Pipeline ([`detect`]): back-project the depth image ([`cloud`]), remove the
-//! supporting planes by RANSAC ([`plane`]), cluster what is left
-//! ([`cluster`]), guess poses from each cluster's principal axes and the
-//! model's ([`hypotheses`]), refine them by point-to-plane ICP against the
-//! model's surface ([`icp`], [`template`]), and judge the result against the
-//! image ([`verify`]): a pose is reported only when the model explains the
-//! measured points and the image does not see through where the model would
-//! be. Symmetric objects are reported modulo their symmetry ([`symmetry`]).
+//! supporting planes by RANSAC ([`plane`]), cut what is left into
+//! object-sized segments ([`segment`], [`cluster`]), start ICP from each
+//! segment's principal axes and from the model's resting poses on the plane
+//! ([`hypotheses`], [`resting`]), rank the coarse fits by a quick check of
+//! the model's visible surface against the image, refine the best by
+//! point-to-plane ICP against the model's surface ([`icp`], [`template`],
+//! [`lookup`]) and by visible-surface agreement ([`freespace`]), and judge
+//! the result against the image ([`verify`]): a pose is reported only when
+//! the model explains the measured points and the image does not see through
+//! where the model would be. Symmetric objects are reported modulo their
+//! symmetry ([`symmetry`]).
 //!
 //! The simulator ([`sim`]) renders a scene file by ray casting its meshes and
 //! primitives with parry3d, seen from the head camera of the robot model, with
@@ -28,10 +32,13 @@ pub mod convert;
 pub mod depth;
 pub mod detect;
 pub mod error;
+pub mod freespace;
 pub mod hypotheses;
 pub mod icp;
+pub mod lookup;
 pub mod plane;
 pub mod resting;
+pub mod segment;
 pub mod service;
 pub mod sim;
 pub mod symmetry;

@@ -11,7 +11,9 @@
 //!
 //! How: the surface is sampled area-uniformly (deterministic ChaCha stream)
 //! at a given spacing, each sample carrying its triangle's outward normal;
-//! samples go into a `kiddo` k-d tree. Principal axes come from the samples
+//! samples go into a `kiddo` k-d tree, and a voxel grid
+//! ([`crate::lookup`]) remembers the nearest sample per cell for the coarse
+//! stages. Principal axes come from the samples
 //! ([`crate::cloud::Moments`]), symmetry from [`crate::symmetry`] with
 //! parry's exact point-to-mesh distance.
 
@@ -29,12 +31,17 @@ use tsukami_body::object::ObjectModel;
 
 use crate::cloud::Moments;
 use crate::error::{Result, VisionError};
+use crate::lookup::SampleGrid;
 use crate::symmetry::Symmetry;
 
 /// Default distance between surface samples (m).
 pub const SAMPLE_SPACING: f64 = 0.002;
 /// Most samples a template keeps.
 const MAX_SAMPLES: usize = 60_000;
+/// Edge of a cell of the nearest-sample grid (m).
+pub const LOOKUP_CELL: f64 = 0.003;
+/// The nearest-sample grid reaches this far beyond the model's box (m).
+pub const LOOKUP_MARGIN: f64 = 0.04;
 
 /// A detector's model of one object.
 pub struct ObjectTemplate {
@@ -47,6 +54,7 @@ pub struct ObjectTemplate {
     /// Outward unit normal of each sample.
     pub normals: Vec<Vector3<f64>>,
     tree: ImmutableKdTree<f64, 3>,
+    lookup: SampleGrid,
     /// Principal axes of the surface.
     pub moments: Moments,
     /// Largest distance of a sample from the centroid (m).
@@ -166,12 +174,16 @@ impl ObjectTemplate {
         let entries: Vec<[f64; 3]> = points.iter().map(|p| [p.x, p.y, p.z]).collect();
         let tree = ImmutableKdTree::new_from_slice(&entries)
             .map_err(|e| model_err(format!("cannot build the k-d tree: {e:?}")))?;
+        let (lo, hi) = model.mesh.aabb();
+        let m = nalgebra::Vector3::repeat(LOOKUP_MARGIN);
+        let lookup = SampleGrid::build(lo - m, hi + m, LOOKUP_CELL, &points);
         Ok(ObjectTemplate {
             name: name.to_owned(),
             model,
             points,
             normals,
             tree,
+            lookup,
             moments,
             radius,
             symmetry,
@@ -188,6 +200,31 @@ impl ObjectTemplate {
             .nearest_one::<SquaredEuclidean<f64>>()
             .execute();
         (r.item as usize, r.distance)
+    }
+
+    /// The surface sample the lookup grid pairs with an object-frame point
+    /// (the nearest to its cell's centre) and its squared distance from the
+    /// point; the distance is infinite for a point outside the grid, which
+    /// is farther than [`LOOKUP_MARGIN`] from the surface.
+    #[inline]
+    pub fn nearest_fast(&self, p: &Point3<f64>) -> (usize, f64) {
+        match self.lookup.get(p) {
+            Some(j) => {
+                let j = j as usize;
+                (j, (self.points[j] - p).norm_squared())
+            }
+            None => (0, f64::INFINITY),
+        }
+    }
+
+    /// The nearest sample, exactly or by the lookup grid.
+    #[inline]
+    pub fn pair(&self, p: &Point3<f64>, fast: bool) -> (usize, f64) {
+        if fast {
+            self.nearest_fast(p)
+        } else {
+            self.nearest(p)
+        }
     }
 
     /// The lowest point of the model under `rotation` (for resting poses):

@@ -49,6 +49,8 @@ pub struct Placement {
 /// One rendered trial.
 #[derive(Debug, Clone)]
 pub struct Trial {
+    /// The seed it was drawn with.
+    pub seed: u64,
     /// The target.
     pub target: Placement,
     /// The target's pose in the robot's base frame (what detection should report).
@@ -265,6 +267,7 @@ impl Testbed {
             all.extend(others.iter().cloned());
             let (image, camera) = self.render(&all, &q, rng.random())?;
             return Ok(Trial {
+                seed,
                 truth: self.scene.robot_base.inverse() * placement.pose,
                 target: placement,
                 others,
