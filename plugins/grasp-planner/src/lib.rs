@@ -32,6 +32,7 @@
 //! ```
 
 pub mod clearance;
+pub mod closing_speed;
 pub mod finger_closing;
 pub mod grasp_type;
 pub mod hand;
