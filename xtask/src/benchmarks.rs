@@ -134,7 +134,7 @@ pub fn run(root: &Path, only: &[String]) -> Result<(), String> {
         eprintln!("== {}: cargo {}", b.name, b.args.join(" "));
         let out = Command::new(&cargo).args(b.args).current_dir(root).output();
         let text = match out {
-            Ok(o) if o.status.success() => String::from_utf8_lossy(&o.stdout).into_owned(),
+            Ok(o) if o.status.success() => without_noise(&String::from_utf8_lossy(&o.stdout)),
             Ok(o) => {
                 failed.push(b.name);
                 format!(
@@ -169,6 +169,20 @@ fn update(page_path: &Path, open: &str, close: &str, body: &str) -> Result<(), S
         .map_err(|e| format!("reading {}: {e}", page_path.display()))?;
     let page = replace_block(&page, open, close, body)?;
     std::fs::write(page_path, page).map_err(|e| format!("writing {}: {e}", page_path.display()))
+}
+
+/// The output without criterion's outlier lists (`Found N outliers…` and
+/// the indented counts below it).
+fn without_noise(text: &str) -> String {
+    let noise = |l: &str| {
+        let t = l.trim_start();
+        (t.starts_with("Found ") && t.contains(" outliers among "))
+            || (l.starts_with(' ') && (t.ends_with(" mild") || t.ends_with(" severe")))
+    };
+    text.lines()
+        .filter(|l| !noise(l))
+        .map(|l| format!("{l}\n"))
+        .collect()
 }
 
 fn ensure_newline(s: &str) -> String {
@@ -259,6 +273,12 @@ mod tests {
             "a\n<!-- x -->\nnew\n<!-- /x -->\nb\n<!-- y -->\nkeep\n<!-- /x -->\n"
         );
         assert!(replace_block(page, "<!-- z -->", "<!-- /x -->", "n").is_err());
+    }
+
+    #[test]
+    fn criterion_outlier_lists_are_dropped() {
+        let out = "g/a\n   time: [1 ns 2 ns 3 ns]\nFound 2 outliers among 100 measurements (2.00%)\n  1 (1.00%) high mild\n  1 (1.00%) low severe\nnext\n";
+        assert_eq!(without_noise(out), "g/a\n   time: [1 ns 2 ns 3 ns]\nnext\n");
     }
 
     #[test]
