@@ -129,9 +129,9 @@ fn solve(
         };
         let sol = ik.solve(palm, true, &q_start, Some(rest));
         if !sol.ok {
-            if start.is_none() {
-                return None; // no nominal here, as in the paper
-            }
+            // Without a solution from the usual start there is no nominal
+            // here, as in the paper.
+            start?;
             continue;
         }
         hand.robot.forward_kinematics(&sol.q, fk);
