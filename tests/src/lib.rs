@@ -69,34 +69,45 @@ pub fn planner_entry() -> PluginEntryConfig {
     grasp_planner_entry("tsukami_grasp_planner")
 }
 
-/// A config entry filling the `grasp-planner` role with plugin `lib_name`, handing it
-/// the repository's models (`models_dir`).
-pub fn grasp_planner_entry(lib_name: &str) -> PluginEntryConfig {
-    let mut entry = plugin_entry(tsukami_msgs::keys::ROLE_GRASP_PLANNER, lib_name);
+/// A config entry loading `lib_name`'s file for `role`, handing the plugin the
+/// repository's models (`models_dir`) and the extra config keys `extra`.
+pub fn models_entry(role: &str, lib_name: &str, extra: &[(&str, &str)]) -> PluginEntryConfig {
+    let mut entry = plugin_entry(role, lib_name);
     let mut table = toml::Table::new();
     table.insert(
         "models_dir".into(),
         models_dir().display().to_string().into(),
     );
+    for (k, v) in extra {
+        table.insert((*k).into(), (*v).into());
+    }
     entry.config = Some(table);
     entry
 }
 
-/// A config entry loading the result viewer with the repository's models, its web
-/// view on a free loopback port (`state` names it).
+/// A config entry filling the `grasp-planner` role with plugin `lib_name`, handing it
+/// the repository's models (`models_dir`).
+pub fn grasp_planner_entry(lib_name: &str) -> PluginEntryConfig {
+    models_entry(tsukami_msgs::keys::ROLE_GRASP_PLANNER, lib_name, &[])
+}
+
+/// A config entry loading the trajectory planner with the repository's models.
+pub fn motion_entry() -> PluginEntryConfig {
+    models_entry(
+        tsukami_msgs::keys::ROLE_TRAJECTORY_PLANNER,
+        "tsukami_trajectory_planner",
+        &[],
+    )
+}
+
+/// A config entry loading the result viewer with the repository's models, its
+/// live view on a free loopback port.
 pub fn viewer_entry() -> PluginEntryConfig {
-    let mut entry = plugin_entry(
+    models_entry(
         tsukami_msgs::keys::ROLE_RESULT_VIEWER,
         "tsukami_result_viewer",
-    );
-    let mut table = toml::Table::new();
-    table.insert(
-        "models_dir".into(),
-        models_dir().display().to_string().into(),
-    );
-    table.insert("web".into(), "127.0.0.1:0".into());
-    entry.config = Some(table);
-    entry
+        &[("web", "127.0.0.1:0")],
+    )
 }
 
 /// A host on a free loopback port with its own namespace, plus a connected client.

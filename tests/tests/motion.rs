@@ -27,7 +27,7 @@ use tsukami_body::model::LinkId;
 use tsukami_bus::client::{BusClient, RequestError};
 use tsukami_controller::joints::JointTable;
 use tsukami_controller::trajectory::Plan;
-use tsukami_e2e::{models_dir, planner_entry, plugin_entry, test_config, TestBus};
+use tsukami_e2e::{models_dir, motion_entry, planner_entry, test_config, TestBus};
 use tsukami_msgs::common::Pose;
 use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER, ROLE_TRAJECTORY_PLANNER};
 use tsukami_msgs::motion::{JointTrajectory, MotionPlanReply};
@@ -42,17 +42,6 @@ const TIMEOUT: Duration = Duration::from_secs(120);
 const FINE: f64 = 1e-3;
 /// How deep a hand link may be in the object while approaching and closing.
 const TOUCH: f64 = 1e-3;
-
-fn motion_entry() -> tsukami::config::PluginEntryConfig {
-    let mut entry = plugin_entry(ROLE_TRAJECTORY_PLANNER, "tsukami_trajectory_planner");
-    let mut table = toml::Table::new();
-    table.insert(
-        "models_dir".into(),
-        models_dir().display().to_string().into(),
-    );
-    entry.config = Some(table);
-    entry
-}
 
 fn bus() -> TestBus {
     TestBus::start(test_config(vec![planner_entry(), motion_entry()]))

@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 use serde_json::Value;
 use tsukami::scenes::run_scene;
 use tsukami_e2e::{
-    cli_plugins_listing, models_dir, planner_entry, plugin_entry, spawn_tsukami, test_config,
+    cli_plugins_listing, models_dir, motion_entry, planner_entry, spawn_tsukami, test_config,
     viewer_entry, TestBus,
 };
 use tsukami_msgs::keys::{ROLE_RESULT_VIEWER, ROLE_TRAJECTORY_PLANNER};
@@ -190,17 +190,6 @@ fn page_shows(browser: &mut cdp::Browser, plans: u64) -> Value {
         assert!(v["error"].is_null(), "the page failed: {}", v["error"]);
         (v["plans"].as_u64() >= Some(plans) && v["shown"] == v["generation"]).then_some(v)
     })
-}
-
-fn motion_entry() -> tsukami::config::PluginEntryConfig {
-    let mut entry = plugin_entry(ROLE_TRAJECTORY_PLANNER, "tsukami_trajectory_planner");
-    let mut table = toml::Table::new();
-    table.insert(
-        "models_dir".into(),
-        models_dir().display().to_string().into(),
-    );
-    entry.config = Some(table);
-    entry
 }
 
 /// Plans the motion to `grasp`; the page's time slider then moves the hand

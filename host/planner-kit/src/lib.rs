@@ -70,6 +70,7 @@ pub mod session;
 pub mod snapshot;
 pub mod validate;
 pub mod verify;
+pub mod world_only;
 
 pub use config::PlannerConfig;
 pub use error::{KitError, NoGrasp, Stop};
