@@ -227,14 +227,23 @@ mod tests {
             // hardly farther (vector propagation keeps a near tie).
             let r = (p - lo) / grid.cell();
             let c = lo + r.map(|v| v.floor() + 0.5) * grid.cell();
-            let best = samples.iter().map(|s| (s - c).norm()).fold(f64::INFINITY, f64::min);
+            let best = samples
+                .iter()
+                .map(|s| (s - c).norm())
+                .fold(f64::INFINITY, f64::min);
             let excess = (samples[j] - c).norm() - best;
             worst = worst.max(excess);
             close += usize::from(excess < 1e-4);
         }
-        assert!(worst < 0.5 * grid.cell(), "{worst} m farther than the nearest");
+        assert!(
+            worst < 0.5 * grid.cell(),
+            "{worst} m farther than the nearest"
+        );
         // Inside a sphere of samples most cells have many near-equidistant ones.
-        assert!(close >= 1300, "{close} of 2000 within 0.1 mm of the nearest");
+        assert!(
+            close >= 1300,
+            "{close} of 2000 within 0.1 mm of the nearest"
+        );
         assert_eq!(grid.get(&Point3::new(0.06, 0.0, 0.0)), None);
         assert_eq!(grid.get(&Point3::new(f64::NAN, 0.0, 0.0)), None);
     }
