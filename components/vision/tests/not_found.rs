@@ -40,6 +40,10 @@ fn wrong_object() {
     let (mut tb, mut det) = setup();
     for (shown, asked, seed) in [
         ("can_350ml", "pet_500ml", 0),
+        // A lying can: the bottle fits its cylinder and sticks out over the
+        // table (0.80, just under the threshold, before verification refused
+        // models seen through on more than 6 % of their pixels).
+        ("can_350ml", "pet_500ml", 108),
         ("can_350ml", "box", 1),
         ("pet_500ml", "box", 1000),
         ("box", "can_350ml", 2000),
@@ -48,8 +52,9 @@ fn wrong_object() {
         let trial = tb.trial(shown, None, 0.0, seed).unwrap();
         match det.detect(asked, &trial.image, &trial.camera).unwrap() {
             Outcome::NotFound(n) => {
+                // Well below the 0.8 threshold, not just under it.
                 if let Some(best) = n.best {
-                    assert!(best.confidence < 0.8, "{best:?}");
+                    assert!(best.confidence < 0.5, "{asked} in {shown} {seed}: {best:?}");
                 }
             }
             Outcome::Found(d) => panic!("{asked} reported in an image of {shown}: {d:?}"),
