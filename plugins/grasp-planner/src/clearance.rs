@@ -5,8 +5,9 @@
 //! and, when the open hand or arm at that pose touches an obstacle (the table
 //! under a lying bottle, the board under a plate), raises the palm in steps of
 //! [`LIFT_STEP`] along the world vertical, up to [`max_lift`] of the OCP,
-//! until it is clear. It returns the first clear pose, or the unlifted one
-//! marked blocked.
+//! until it is clear; at the highest lift, a finger still on an obstacle is
+//! flexed instead ([`PRE_FLEX`]: its Δa_i joints, toward their upper limits).
+//! It returns the first clear pose, or the unlifted one marked blocked.
 //!
 //! Why: the paper centres GRCdes on the OCP, which on a low or lying object
 //! puts the open fingers and the thumb below the support's top, so every
@@ -148,6 +149,48 @@ fn solve(
     first
 }
 
+/// How far a finger that rests on an obstacle is flexed before sampling:
+/// fractions of the way from the pre-shape to its flexing joints' upper
+/// limits, tried in turn.
+pub const PRE_FLEX: [f64; 2] = [0.3, 0.6];
+
+/// `q` with the finger that touches an obstacle flexed (its contact's
+/// `perturb` joints, the ones Δa_i moves) by the first [`PRE_FLEX`] fraction
+/// that clears `around`; `None` if none does, or if no finger is the one
+/// touching.
+fn pre_flex(
+    hand: &HandModel,
+    links: &LinkSets,
+    t: usize,
+    q: &[f64],
+    around: &Surroundings<'_>,
+    fk: &mut FkState,
+) -> Option<Vec<f64>> {
+    hand.robot.forward_kinematics(q, fk);
+    let hit = hand
+        .collision
+        .first_collision(fk, &links.moving, around.env, 0.0)?;
+    let finger = hand.types[t]
+        .contacts
+        .iter()
+        .find(|c| crate::finger_closing::moved_links(hand, c.joint, c.link).contains(&hit.link))?;
+    for f in PRE_FLEX {
+        let mut flexed = q.to_vec();
+        for &j in &finger.perturb {
+            let upper = hand.robot.joints[j].limits.upper;
+            if upper.is_finite() && upper > q[j] {
+                flexed[j] = q[j] + f * (upper - q[j]);
+            }
+        }
+        hand.robot.apply_mimics(&mut flexed);
+        hand.robot.forward_kinematics(&flexed, fk);
+        if verdict(hand, links, fk, around) == Verdict::Clear {
+            return Some(flexed);
+        }
+    }
+    None
+}
+
 /// The nominal `palm`, lifted as little as [`LIFT_STEP`] steps up to `lift`
 /// allow so that `links` clear `around` (see the module docs); `None` when
 /// the unlifted pose has no IK solution. `q0` holds the grasp type's posture.
@@ -159,11 +202,12 @@ pub fn clear_nominal(
     palm: &Isometry3<f64>,
     (q0, q_init): (&[f64], &[f64]),
     around: &Surroundings<'_>,
-    lift: f64,
+    (t, lift): (usize, f64),
     fk: &mut FkState,
 ) -> Option<Cleared> {
     let steps = (lift / LIFT_STEP).floor() as usize;
     let mut first: Option<Cleared> = None;
+    let mut highest: Option<(Isometry3<f64>, Vec<f64>)> = None;
     for k in 0..=steps {
         let up = Vector3::z() * (k as f64 * LIFT_STEP);
         let p = Isometry3::from_parts(
@@ -186,11 +230,22 @@ pub fn clear_nominal(
         }
         first.get_or_insert(Cleared {
             palm: p,
-            q,
+            q: q.clone(),
             blocked,
         });
         if v == Verdict::Other {
-            break;
+            return first;
+        }
+        highest = Some((p, q));
+    }
+    // Lifted as far as allowed and a finger still on an obstacle: flex it.
+    if let Some((p, q)) = highest {
+        if let Some(q) = pre_flex(hand, links, t, &q, around, fk) {
+            return Some(Cleared {
+                palm: p,
+                q,
+                blocked: false,
+            });
         }
     }
     first

@@ -354,7 +354,7 @@ impl Paper {
                     &target.palm,
                     (&q0, &q_init),
                     &around,
-                    max_lift(ocp),
+                    (cand.grasp_type, max_lift(ocp)),
                     &mut fk,
                 ) else {
                     continue;

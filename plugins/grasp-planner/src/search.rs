@@ -265,9 +265,9 @@ pub fn search(
             counters.reject(0, None);
             continue;
         }
+        // The nominal's hand posture (the reference posture, or its
+        // pre-flexed form, `crate::clearance`) + Δa_i.
         q.copy_from_slice(&sol.q);
-        // Reference posture + Δa_i.
-        hand.set_posture(t, &mut q);
         if s > 0 {
             for c in &spec.contacts {
                 for &j in &c.perturb {
