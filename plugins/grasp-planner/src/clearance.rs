@@ -152,7 +152,7 @@ fn solve(
 /// How far a finger that rests on an obstacle is flexed before sampling:
 /// fractions of the way from the pre-shape to its flexing joints' upper
 /// limits, tried in turn.
-pub const PRE_FLEX: [f64; 2] = [0.3, 0.6];
+pub const PRE_FLEX: [f64; 3] = [0.3, 0.6, 0.9];
 
 /// `q` with the finger that touches an obstacle flexed (its contact's
 /// `perturb` joints, the ones Δa_i moves) by the first [`PRE_FLEX`] fraction
