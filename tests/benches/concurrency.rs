@@ -142,17 +142,24 @@ fn before_after(before: &str, before_models: &str) {
         .expect("the older host answers");
     let new = TestBus::start(test_config(vec![planner_entry()]));
     println!("plan p50 over the bus, {SEEDS} seeds, older build vs this build (same run);");
-    println!("verified: replies with a grasp that pass tsukami_scenes::verify on this build's world");
+    println!(
+        "verified: replies with a grasp that pass tsukami_scenes::verify on this build's world"
+    );
     println!(
         "{:<11} {:>10} {:>10} {:>9} {:>13}",
         "scene", "before ms", "after ms", "after/bef", "verified b/a"
     );
     for scene in PAPER_SCENES {
         let (mut p50, mut ok) = (Vec::new(), Vec::new());
-        let path = models_dir().join("scenes").join(format!("{}.toml", scene.name));
+        let path = models_dir()
+            .join("scenes")
+            .join(format!("{}.toml", scene.name));
         let r = scene_requests(&path).unwrap();
         let world = World::from_requests(&models_dir(), &r.robot, &r.object, &r.env).unwrap();
-        for (c, models) in [(&old, Path::new(before_models)), (&new.client, &models_dir())] {
+        for (c, models) in [
+            (&old, Path::new(before_models)),
+            (&new.client, &models_dir()),
+        ] {
             set_scene(c, models, scene.name);
             let (times, replies): (Vec<_>, Vec<_>) = (0..SEEDS).map(|s| plan_reply(c, s)).unzip();
             let found: Vec<Vec<u8>> = replies.into_iter().flatten().collect();
