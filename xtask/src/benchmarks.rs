@@ -28,82 +28,18 @@ pub struct Bench {
 }
 
 /// Every bench target whose output the page holds, in page order.
+#[rustfmt::skip]
 pub const BENCHES: &[Bench] = &[
-    Bench {
-        name: "roundtrip",
-        args: &["bench", "-p", "tsukami-e2e", "--bench", "roundtrip"],
-    },
-    Bench {
-        name: "viewer",
-        args: &["bench", "-p", "tsukami-e2e", "--bench", "viewer"],
-    },
-    Bench {
-        name: "body",
-        args: &[
-            "bench",
-            "-p",
-            "tsukami-body",
-            "--bench",
-            "body",
-            "--",
-            "--warm-up-time",
-            "1",
-            "--measurement-time",
-            "3",
-        ],
-    },
-    Bench {
-        name: "force_closure",
-        args: &[
-            "bench",
-            "-p",
-            "tsukami-grasp",
-            "--bench",
-            "force_closure",
-            "--",
-            "--warm-up-time",
-            "1",
-            "--measurement-time",
-            "3",
-        ],
-    },
-    Bench {
-        name: "fc_default",
-        args: &["bench", "-p", "tsukami", "--bench", "fc_default"],
-    },
-    Bench {
-        name: "plan_scenes",
-        args: &["bench", "-p", "tsukami-e2e", "--bench", "plan_scenes"],
-    },
-    Bench {
-        name: "concurrency",
-        args: &["bench", "-p", "tsukami-e2e", "--bench", "concurrency"],
-    },
-    Bench {
-        name: "object_bench",
-        args: &[
-            "run",
-            "--release",
-            "-p",
-            "tsukami-grasp-planner",
-            "--example",
-            "object_bench",
-        ],
-    },
-    Bench {
-        name: "motion_scenes",
-        args: &[
-            "bench",
-            "-p",
-            "tsukami-trajectory-planner",
-            "--bench",
-            "motion_scenes",
-        ],
-    },
-    Bench {
-        name: "vision",
-        args: &["bench", "-p", "tsukami-vision", "--bench", "vision"],
-    },
+    Bench { name: "roundtrip", args: &["bench", "-p", "tsukami-e2e", "--bench", "roundtrip"] },
+    Bench { name: "viewer", args: &["bench", "-p", "tsukami-e2e", "--bench", "viewer"] },
+    Bench { name: "body", args: &["bench", "-p", "tsukami-body", "--bench", "body", "--", "--warm-up-time", "1", "--measurement-time", "3"] },
+    Bench { name: "force_closure", args: &["bench", "-p", "tsukami-grasp", "--bench", "force_closure", "--", "--warm-up-time", "1", "--measurement-time", "3"] },
+    Bench { name: "fc_default", args: &["bench", "-p", "tsukami", "--bench", "fc_default"] },
+    Bench { name: "plan_scenes", args: &["bench", "-p", "tsukami-e2e", "--bench", "plan_scenes"] },
+    Bench { name: "concurrency", args: &["bench", "-p", "tsukami-e2e", "--bench", "concurrency"] },
+    Bench { name: "object_bench", args: &["run", "--release", "-p", "tsukami-grasp-planner", "--example", "object_bench"] },
+    Bench { name: "motion_scenes", args: &["bench", "-p", "tsukami-trajectory-planner", "--bench", "motion_scenes"] },
+    Bench { name: "vision", args: &["bench", "-p", "tsukami-vision", "--bench", "vision"] },
 ];
 
 /// Runs the chosen benches (all when `only` is empty) and rewrites `page`.

@@ -44,6 +44,16 @@ pub trait WorldOnlyInfo: Send + Sync + 'static {
 /// The kit's world with nothing derived, for the plugin `I` names.
 pub struct WorldOnly<I>(PhantomData<I>);
 
+impl<I: WorldOnlyInfo> WorldOnly<I> {
+    /// The world session of a plugin whose config is `config`: the kit's keys
+    /// (model roots, limits) for the world, the plugin's own keys left to it.
+    pub fn session(config: &PlannerConfig) -> Result<crate::Session<Self>, String> {
+        let mut world = config.clone();
+        world.planner = toml::Table::new();
+        crate::Session::from_config(world)
+    }
+}
+
 impl<I: WorldOnlyInfo> GraspPlanner for WorldOnly<I> {
     type RobotData = ();
     type ObjectData = ();

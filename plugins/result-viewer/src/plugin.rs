@@ -32,12 +32,13 @@ use serde::Deserialize;
 use serde_json::json;
 use tsukami_msgs::error::parse_request;
 use tsukami_msgs::keys::{world, ROLE_RESULT_VIEWER};
-use tsukami_planner_kit::{PlannerConfig, Session};
+use tsukami_planner_kit::PlannerConfig;
 use tsukami_plugin_api::{CallContext, CallError, Host, LogLevel, Plugin, PluginInfo};
 
 use crate::latest::Board;
 use crate::viewer::{Viewer, DEFAULT_EYE};
 use crate::web::WebServer;
+use crate::world::ViewerWorld;
 
 /// The default address of the web view.
 pub const DEFAULT_WEB: &str = "127.0.0.1:17448";
@@ -240,13 +241,8 @@ impl Plugin for ViewerPlugin {
     fn new(host: Host, config: &str) -> Result<Self, String> {
         let config = PlannerConfig::parse(config)?;
         let web = web_config(&config.planner)?;
-        let mut world_config = config.clone();
-        world_config.planner = toml::Table::new();
         let board = Arc::new(Board::default());
-        let viewer = Arc::new(Viewer::new(
-            Session::from_config(world_config)?,
-            board.clone(),
-        ));
+        let viewer = Arc::new(Viewer::new(ViewerWorld::session(&config)?, board.clone()));
         let server = match web.addr {
             Some(addr) => {
                 let server = WebServer::start(addr, web.fallback, web.max_clients, viewer.clone())

@@ -236,10 +236,8 @@ impl Plugin for TrajectoryPlugin {
     fn new(host: Host, config: &str) -> Result<Self, String> {
         let config = PlannerConfig::parse(config)?;
         let (motion, controller_timeout) = motion_config(&config.planner)?;
-        let mut world_config = config.clone();
-        world_config.planner = toml::Table::new();
         Ok(TrajectoryPlugin {
-            session: Session::from_config(world_config)?,
+            session: SharedWorld::session(&config)?,
             config,
             motion,
             host,
