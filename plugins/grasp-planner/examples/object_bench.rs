@@ -75,9 +75,28 @@ fn run_case(
         ms: 0.0,
         why: String::new(),
     };
-    if let Err(e) = planner.set_object(&req).and_then(|_| planner.set_env(&env)) {
-        out.why = format!("refused: {e}");
-        return out;
+    let summary = match planner
+        .set_object(&req)
+        .and_then(|s| planner.set_env(&env).map(|_| s))
+    {
+        Ok(s) => s,
+        Err(e) => {
+            out.why = format!("refused: {e}");
+            return out;
+        }
+    };
+    if verbose {
+        for o in &summary.regions {
+            println!(
+                "    region {} extents [{:.3}, {:.3}, {:.3}] at {:?} free {:?}",
+                o.region,
+                o.extents[0],
+                o.extents[1],
+                o.extents[2],
+                o.pose.position,
+                o.free_faces.iter().map(|f| f.as_str()).collect::<Vec<_>>()
+            );
+        }
     }
     let opts = PlanOptions {
         seed,

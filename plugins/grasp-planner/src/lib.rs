@@ -45,5 +45,6 @@ pub mod plugin;
 pub mod search;
 pub mod selection;
 pub mod support;
+pub mod tight_box;
 pub mod verify;
 pub mod whole_body;

@@ -64,6 +64,11 @@ pub struct OcpParams {
     pub support_tolerance: f64,
     /// Maximum number of regions.
     pub max_regions: usize,
+    /// The object's box turns to the tightest box about a principal axis or
+    /// the vertical ([`crate::tight_box`]) when that box's volume is below
+    /// this fraction of the principal-axes box's (a mug's handle tilts the
+    /// principal axes; a can's or a vase's are already tight).
+    pub tight_box_ratio: f64,
 }
 
 impl Default for OcpParams {
@@ -78,6 +83,7 @@ impl Default for OcpParams {
             min_region_fraction: 0.08,
             support_tolerance: 0.01,
             max_regions: 4,
+            tight_box_ratio: 0.9,
         }
     }
 }
@@ -295,6 +301,25 @@ fn box_from_axes(patch: &Patch, rotation: Rotation3<f64>, region: usize) -> Ocp 
     }
 }
 
+/// The tightest box about a principal axis or the vertical instead of `pca`
+/// when it is much smaller (see [`OcpParams::tight_box_ratio`]).
+fn tighten(pca: Ocp, whole: &Patch, vertices: &[Point3<f64>], params: &OcpParams) -> Ocp {
+    let m = pca.rotation.matrix();
+    let axes = [
+        m.column(0).into_owned(),
+        m.column(1).into_owned(),
+        m.column(2).into_owned(),
+        Vector3::z(),
+    ];
+    let pca_volume = pca.extents.product();
+    match crate::tight_box::tightest_rotation(vertices, &axes) {
+        Some((rotation, v)) if v < params.tight_box_ratio * pca_volume => {
+            box_from_axes(whole, rotation, pca.region)
+        }
+        _ => pca,
+    }
+}
+
 /// Clips a convex polygon to the half-space `axis·x ≥ t` (`keep_above`) or `≤ t`.
 fn clip(poly: &[Vector3<f64>], axis: &Vector3<f64>, t: f64, keep_above: bool) -> Vec<Vector3<f64>> {
     let side = |p: &Vector3<f64>| {
@@ -460,6 +485,7 @@ pub fn object_ocps(
     let Some(global) = patch_box(&whole, params, 0) else {
         return Vec::new();
     };
+    let global = tighten(global, &whole, vertices, params);
     // Split along the longest box axis.
     let long = global.extents.imax();
     let axis = global.rotation.matrix().column(long).into_owned();

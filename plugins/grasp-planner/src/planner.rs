@@ -160,10 +160,14 @@ impl GraspPlanner for Paper {
                     .fold(f64::INFINITY, f64::min)
             });
         let mut selection = select(&types, &ocps, object.mass);
-        for c in &mut selection.candidates {
+        for c in selection
+            .candidates
+            .iter_mut()
+            .chain(&mut selection.fallback)
+        {
             c.grasp_type = enabled[c.grasp_type];
         }
-        if selection.candidates.is_empty() {
+        if selection.candidates.is_empty() && selection.fallback.is_empty() {
             return Err(NoGrasp::NoGraspType(selection.explain(&types)));
         }
         let params = SearchParams {
@@ -172,83 +176,45 @@ impl GraspPlanner for Paper {
             contact_distance: hand.contact_distance,
             ..self.params.search.clone()
         };
-        let deadline = run.deadline().unwrap_or_else(far_future);
         let ctx = SearchContext {
             hand,
             object,
             env: &w.obstacles,
             cancel: run.cancel_flag(),
-            deadline,
+            deadline: run.deadline().unwrap_or_else(far_future),
             params: &params,
         };
-        let mut counters = Counters::default();
-        let mut any_reachable = false;
-        let mut last_stage = String::from("the arm");
-        for (si, stage) in stages(hand, opts.whole_body).into_iter().enumerate() {
-            let extra = hand.names(&stage.extra);
-            last_stage = match extra.is_empty() {
-                true => "the arm".into(),
-                false => format!("the arm and {}", extra.join(", ")),
-            };
-            run.phase(PlanPhase::NominalPose, None, &extra);
-            let mut nominals = self.nominals(
-                hand,
-                object,
-                &selection.candidates,
-                &stage,
-                opts,
-                (si, floor, &w.obstacles),
-                run,
-            )?;
-            if nominals.is_empty() {
-                continue;
-            }
-            any_reachable = true;
-            // Approaches the support or an obstacle blocks go last; then by cost.
-            nominals.sort_by(|a, b| a.blocked.cmp(&b.blocked).then(a.cost.total_cmp(&b.cost)));
-            for (k, nom) in nominals
-                .iter()
-                .take(opts.max_candidates.max(1) as usize)
-                .enumerate()
+        let mut tiers = Tiers {
+            counters: Counters::default(),
+            any_reachable: false,
+            last_stage: String::from("the arm"),
+        };
+        // The mass range's preferred types on every stage first, then the
+        // types that fit in size only (`Selection::fallback`).
+        for (tier, candidates) in [&selection.candidates, &selection.fallback]
+            .into_iter()
+            .enumerate()
+        {
+            if let Some(g) =
+                self.search_tier(w, opts, run, &ctx, (tier, candidates), floor, &mut tiers)?
             {
-                let g = &all[nom.candidate.grasp_type];
-                run.tried(&g.name);
-                run.phase(PlanPhase::Search, Some(&g.name), &extra);
-                let seed = opts
-                    .seed
-                    .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-                    .wrapping_add(((si as u64) << 16) | k as u64);
-                let t = nom.candidate.grasp_type;
-                let outcome = search(
-                    &ctx,
-                    t,
-                    &stage,
-                    &nom.palm,
-                    &nom.q,
-                    seed,
-                    &mut counters,
-                    &mut |_| {},
-                );
-                run.record(counters.samples, counters.best_margin);
-                match outcome {
-                    Outcome::Found(found) => {
-                        run.phase(PlanPhase::Verification, Some(&g.name), &extra);
-                        return Ok(grasp(g.to_ref(), &nom.candidate, &stage, *found, object));
-                    }
-                    Outcome::Cancelled => return Err(Stop::Cancelled.into()),
-                    Outcome::OutOfTime => {
-                        return Err(run.check().err().unwrap_or(Stop::Cancelled).into())
-                    }
-                    Outcome::Exhausted => {}
-                }
+                return Ok(g);
             }
         }
-        record_rejections(run, &counters);
-        Err(match any_reachable {
-            false => NoGrasp::Unreachable(last_stage),
+        record_rejections(run, &tiers.counters);
+        Err(match tiers.any_reachable {
+            false => NoGrasp::Unreachable(tiers.last_stage),
             true => NoGrasp::Exhausted,
         })
     }
+}
+
+/// What the tiers of one plan share: the search's counts and whether any
+/// nominal pose was reachable (and on which stage last).
+struct Tiers {
+    counters: Counters,
+    any_reachable: bool,
+    last_stage: String,
 }
 
 /// Hands the search's counts to the kit: every reason of
@@ -302,6 +268,95 @@ fn grasp(
 }
 
 impl Paper {
+    /// Every whole-body stage in turn for one tier of candidates: the nominal
+    /// poses, then Algorithm 1 on the best few. `Some` with the first grasp.
+    #[allow(clippy::too_many_arguments)]
+    fn search_tier(
+        &self,
+        w: &World<'_, Self>,
+        opts: &PlanOptions,
+        run: &mut Run,
+        ctx: &SearchContext<'_>,
+        (tier, candidates): (usize, &[Candidate]),
+        floor: Option<f64>,
+        t: &mut Tiers,
+    ) -> Result<Option<Grasp>, NoGrasp> {
+        let (hand, object, all) = (
+            w.robot_data,
+            w.object_data,
+            &w.robot_data.config.grasp_types,
+        );
+        if candidates.is_empty() {
+            return Ok(None);
+        }
+        for (si, stage) in stages(hand, opts.whole_body).into_iter().enumerate() {
+            let extra = hand.names(&stage.extra);
+            t.last_stage = match extra.is_empty() {
+                true => "the arm".into(),
+                false => format!("the arm and {}", extra.join(", ")),
+            };
+            run.phase(PlanPhase::NominalPose, None, &extra);
+            let mut nominals = self.nominals(
+                hand,
+                object,
+                candidates,
+                &stage,
+                opts,
+                (si, floor, &w.obstacles),
+                run,
+            )?;
+            if nominals.is_empty() {
+                continue;
+            }
+            t.any_reachable = true;
+            // Approaches the support or an obstacle blocks go last; then by cost.
+            nominals.sort_by(|a, b| a.blocked.cmp(&b.blocked).then(a.cost.total_cmp(&b.cost)));
+            for (k, nom) in nominals
+                .iter()
+                .take(opts.max_candidates.max(1) as usize)
+                .enumerate()
+            {
+                let g = &all[nom.candidate.grasp_type];
+                run.tried(&g.name);
+                run.phase(PlanPhase::Search, Some(&g.name), &extra);
+                let seed = opts
+                    .seed
+                    .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+                    .wrapping_add(((tier as u64) << 32) | ((si as u64) << 16) | k as u64);
+                let ti = nom.candidate.grasp_type;
+                let outcome = search(
+                    ctx,
+                    ti,
+                    &stage,
+                    &nom.palm,
+                    &nom.q,
+                    seed,
+                    &mut t.counters,
+                    &mut |_| {},
+                );
+                run.record(t.counters.samples, t.counters.best_margin);
+                match outcome {
+                    Outcome::Found(found) => {
+                        run.phase(PlanPhase::Verification, Some(&g.name), &extra);
+                        return Ok(Some(grasp(
+                            g.to_ref(),
+                            &nom.candidate,
+                            &stage,
+                            *found,
+                            object,
+                        )));
+                    }
+                    Outcome::Cancelled => return Err(Stop::Cancelled.into()),
+                    Outcome::OutOfTime => {
+                        return Err(run.check().err().unwrap_or(Stop::Cancelled).into())
+                    }
+                    Outcome::Exhausted => {}
+                }
+            }
+        }
+        Ok(None)
+    }
+
     /// The nominal palm poses of one stage that have an IK solution (section 3.2).
     #[allow(clippy::too_many_arguments)]
     fn nominals(

@@ -16,6 +16,14 @@
 //! across the approach vector must lie between GRCmin and GRCmax in one of the
 //! two in-plane orientations (the other two of the four rotations of section
 //! 3.2 are their mirror images and are resolved by [`crate::palm_pose`]).
+//!
+//! The mass range of eqs. (4)–(5) is a preference, not a wall: a type that fits
+//! the size but not the mass is kept in [`Selection::fallback`], searched only
+//! after every preferred candidate failed on every whole-body stage, and only
+//! when the object is within the hand's capacity (the largest `m_max` of all
+//! types). The exact force-closure check with the weight still decides. A
+//! lying 0.5 kg bottle that no envelope type can wrap on a table is then held
+//! by the fingertips; an object heavier than every type stays refused.
 
 use nalgebra::Vector3;
 use tsukami_msgs::planner::BoxFace;
@@ -77,6 +85,10 @@ pub struct Selection {
     pub candidates: Vec<Candidate>,
     /// `(grasp type, region, reason)` of every rejected pair.
     pub rejected: Vec<(usize, usize, Rejection)>,
+    /// Candidates that fit in size but not in the type's mass range (eqs.
+    /// (4)–(5)) while the hand as a whole can carry the object: tried after
+    /// all of [`Selection::candidates`] failed, ordered the same way.
+    pub fallback: Vec<Candidate>,
 }
 
 impl Selection {
@@ -116,6 +128,8 @@ pub fn grc_edges_in_palm(grc: &GrcBox, approach: &Vector3<f64>) -> (Vector3<f64>
 /// feasible free face, ordered by eq. (3).
 pub fn select(types: &[GraspType], ocps: &[Ocp], mass: f64) -> Selection {
     let mut sel = Selection::default();
+    // The hand's capacity: the heaviest object some type admits.
+    let capacity = types.iter().map(|g| g.mass[1]).fold(0.0, f64::max);
     for (i, g) in types.iter().enumerate() {
         let (e_max, e_min, e_des) = (
             sorted(&g.grc_max.edges()),
@@ -139,30 +153,33 @@ pub fn select(types: &[GraspType], ocps: &[Ocp], mass: f64) -> Selection {
             } else {
                 None
             };
+            let mass_only = matches!(why, Some(Rejection::TooHeavy | Rejection::TooLight));
             if let Some(why) = why {
                 sel.rejected.push((i, o.region, why));
-                continue;
-            }
-            let score = (e_des - e_o).norm(); // eq. (3)
-            let mut any = false;
-            for face in o.free_faces() {
-                if face_fits(g, o, face) {
-                    sel.candidates.push(Candidate {
-                        grasp_type: i,
-                        region: o.region,
-                        face,
-                        score,
-                    });
-                    any = true;
+                if !(mass_only && mass < capacity) {
+                    continue;
                 }
             }
-            if !any {
+            let faces: Vec<BoxFace> = o.free_faces().filter(|&f| face_fits(g, o, f)).collect();
+            if faces.is_empty() && !mass_only {
                 sel.rejected.push((i, o.region, Rejection::NoFreeFace));
             }
+            let into = match mass_only {
+                true => &mut sel.fallback,
+                false => &mut sel.candidates,
+            };
+            let score = (e_des - e_o).norm(); // eq. (3)
+            into.extend(faces.into_iter().map(|face| Candidate {
+                grasp_type: i,
+                region: o.region,
+                face,
+                score,
+            }));
         }
     }
     // Stable: equal scores keep type order, then region, then face order.
     sel.candidates.sort_by(|a, b| a.score.total_cmp(&b.score));
+    sel.fallback.sort_by(|a, b| a.score.total_cmp(&b.score));
     sel
 }
 
