@@ -43,6 +43,8 @@
 use std::collections::HashSet;
 use std::path::{Component, Path, PathBuf};
 
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+
 use crate::error::{BodyError, LoadWarning};
 use crate::limits::{read_bounded, ParseLimits};
 use crate::urdf_xml::{read_robot, Diagnostics, RawPose, RawRobot, RawShape};
@@ -103,6 +105,100 @@ pub enum ComposeError {
         /// The clashing names (after the prefix), at most 10.
         names: Vec<String>,
     },
+}
+
+/// A frame link inserted above a hand's root (see [`insert_frame`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    /// Name of the new link (e.g. `palm`).
+    pub name: String,
+    /// Its pose in the frame of the link it goes above (the hand's root).
+    pub origin: RawPose,
+}
+
+/// Inserts an empty link `frame.name` between link `below` and its parent
+/// joint, so that `below` keeps its place: the parent joint now ends at the
+/// new link (its origin times `frame.origin`), and a fixed joint
+/// `<name>_to_<below>` carries the inverse of `frame.origin`. When `below` is
+/// a root, the new link becomes the root.
+///
+/// Why: the planner's palm frame is a link's frame (+z palm normal, +x toward
+/// the fingertips, `docs/grasp-types.md`); a hand whose palm link has other
+/// axes gets a frame link with the convention's axes that is still an
+/// ancestor of every finger, without editing the hand's file.
+pub fn insert_frame(robot: &mut RawRobot, below: &str, frame: &Frame) -> Result<(), ComposeError> {
+    if !robot.links.iter().any(|l| l.name == below) {
+        return Err(ComposeError::NoSuchLink {
+            arm: robot.name.clone(),
+            link: below.to_owned(),
+        });
+    }
+    let joint = format!("{}_to_{below}", frame.name);
+    let clash = |names: Vec<&str>, n: &str| names.contains(&n);
+    for (what, taken, name) in [
+        (
+            "links",
+            robot.links.iter().map(|l| l.name.as_str()).collect(),
+            &frame.name,
+        ),
+        (
+            "joints",
+            robot.joints.iter().map(|j| j.name.as_str()).collect(),
+            &joint,
+        ),
+    ] {
+        if clash(taken, name) {
+            return Err(ComposeError::Clash {
+                what,
+                names: vec![name.clone()],
+            });
+        }
+    }
+    let offset = to_isometry(&frame.origin);
+    if let Some(j) = robot.joints.iter_mut().find(|j| j.child == below) {
+        j.origin = from_isometry(&(to_isometry(&j.origin) * offset));
+        j.child = frame.name.clone();
+    }
+    robot.links.push(crate::urdf_xml::RawLink {
+        name: frame.name.clone(),
+        inertial: None,
+        visuals: Vec::new(),
+        collisions: Vec::new(),
+    });
+    robot.joints.push(crate::urdf_xml::RawJoint {
+        name: joint,
+        kind: "fixed".into(),
+        parent: frame.name.clone(),
+        child: below.to_owned(),
+        origin: from_isometry(&offset.inverse()),
+        axis: [1.0, 0.0, 0.0],
+        limit: None,
+        mimic: None,
+    });
+    Ok(())
+}
+
+fn to_isometry(p: &RawPose) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(p.xyz[0], p.xyz[1], p.xyz[2]),
+        UnitQuaternion::from_euler_angles(p.rpy[0], p.rpy[1], p.rpy[2]),
+    )
+}
+
+fn from_isometry(m: &Isometry3<f64>) -> RawPose {
+    let (r, p, y) = m.rotation.euler_angles();
+    let t = m.translation.vector;
+    // Round-off below a femtometre or femtoradian written as 0.
+    let clean = |v: [f64; 3]| v.map(|x| if x.abs() < 1e-15 { 0.0 } else { x });
+    RawPose {
+        xyz: clean([t.x, t.y, t.z]),
+        rpy: clean([r, p, y]),
+    }
+}
+
+/// The hand's root link (the one link no joint has as child), before any prefix.
+pub fn root_link(hand: &RawRobot) -> Result<String, ComposeError> {
+    hand_root(hand)
 }
 
 /// The arm with the hand attached. `dirs` are the folders of the arm's file,
@@ -293,5 +389,56 @@ mod tests {
         assert_eq!(r, PathBuf::from("../../b/meshes/m.stl"));
         let same = relative_to(Path::new("/a/b/./m.stl"), Path::new("/a/b"));
         assert_eq!(same, PathBuf::from("m.stl"));
+    }
+
+    fn pose_of(robot: &RawRobot, child: &str) -> Isometry3<f64> {
+        let j = robot.joints.iter().find(|j| j.child == child).unwrap();
+        let up = robot.links.iter().any(|l| l.name == j.parent)
+            && robot.joints.iter().any(|k| k.child == j.parent);
+        let parent = if up {
+            pose_of(robot, &j.parent)
+        } else {
+            Isometry3::identity()
+        };
+        parent * to_isometry(&j.origin)
+    }
+
+    #[test]
+    fn an_inserted_frame_keeps_the_link_in_place() {
+        let xml = r#"<robot name="r"><link name="base"/><link name="palm_link"/><link name="tip"/>
+          <joint name="mount" type="fixed"><origin xyz="0.1 0 0.2" rpy="0.3 0.2 0.1"/>
+            <parent link="base"/><child link="palm_link"/></joint>
+          <joint name="f" type="revolute"><parent link="palm_link"/><child link="tip"/>
+            <limit lower="0" upper="1"/></joint></robot>"#;
+        let mut d = Diagnostics::new("x.urdf".into(), false);
+        let mut robot = read_robot(xml, &mut d, &Default::default()).unwrap();
+        let before = pose_of(&robot, "palm_link");
+        let frame = Frame {
+            name: "palm".into(),
+            origin: RawPose {
+                xyz: [0.011, 0.0, -0.0475],
+                rpy: [0.0, -std::f64::consts::FRAC_PI_2, std::f64::consts::PI],
+            },
+        };
+        insert_frame(&mut robot, "palm_link", &frame).unwrap();
+        let after = pose_of(&robot, "palm_link");
+        assert!(
+            (before.to_homogeneous() - after.to_homogeneous())
+                .abs()
+                .max()
+                < 1e-12
+        );
+        let palm = pose_of(&robot, "palm");
+        let expected = before * to_isometry(&frame.origin);
+        assert!(
+            (palm.to_homogeneous() - expected.to_homogeneous())
+                .abs()
+                .max()
+                < 1e-12
+        );
+        let again = insert_frame(&mut robot, "palm_link", &frame).unwrap_err();
+        assert!(again.to_string().contains("palm"), "{again}");
+        let missing = insert_frame(&mut robot, "nope", &frame).unwrap_err();
+        assert!(missing.to_string().contains("nope"), "{missing}");
     }
 }

@@ -58,6 +58,7 @@ pub mod description;
 pub mod env;
 pub mod error;
 pub mod grasp;
+pub mod grasp_derive;
 pub mod grasp_types;
 pub mod mesh_topology;
 pub mod models;

@@ -1,4 +1,5 @@
-//! `tsukami model inspect|fk|ik|compose`: the body library on the command line.
+//! `tsukami model inspect|fk|ik|compose|grasp-types`: the body library (and the
+//! planner kit's grasp-type derivation) on the command line.
 //!
 //! Output field names are a contract external tools rely on (see
 //! [`super::model_report`], which defines them); `--batch FILE` runs thousands of
@@ -56,6 +57,18 @@ pub enum ModelCommand {
         #[arg(long, conflicts_with = "target")]
         batch: Option<PathBuf>,
     },
+    /// Proposes the paper's grasp types (reference postures and GRC boxes) for
+    /// a robot's first hand from its kinematics and writes a grasp-type file
+    /// to review (`docs/grasp-types.md`).
+    GraspTypes {
+        /// The robot's folder (holding `description.toml`) or its description file.
+        robot: PathBuf,
+        /// Where to write the file (default: standard output).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+        #[command(flatten)]
+        load: LoadArgs,
+    },
     /// Attaches a hand's URDF to a link of an arm's (or humanoid's) URDF with a
     /// fixed joint and writes the composed URDF; neither input is changed.
     Compose(ComposeArgs),
@@ -83,6 +96,29 @@ pub struct ComposeArgs {
     /// The composed robot's name (default `<arm>_<hand>`).
     #[arg(long)]
     pub name: Option<String>,
+    /// Inserts an empty link of this name above the hand's root, at
+    /// `--palm-xyz`/`--palm-rpy` in the root's frame: a palm frame with the
+    /// planner's axes (+z palm normal, +x toward the fingertips) for a hand
+    /// whose own palm link has other axes; name it as `palm_link` in the
+    /// robot description.
+    #[arg(long, value_name = "NAME")]
+    pub palm_frame: Option<String>,
+    /// Position of the palm frame in the hand root's frame, `x,y,z` (m).
+    #[arg(
+        long,
+        default_value = "0,0,0",
+        allow_hyphen_values = true,
+        requires = "palm_frame"
+    )]
+    pub palm_xyz: String,
+    /// Orientation of the palm frame in the hand root's frame, `roll,pitch,yaw` (rad).
+    #[arg(
+        long,
+        default_value = "0,0,0",
+        allow_hyphen_values = true,
+        requires = "palm_frame"
+    )]
+    pub palm_rpy: String,
     /// Where to write the composed URDF (default: standard output).
     #[arg(long, short)]
     pub out: Option<PathBuf>,
@@ -144,6 +180,26 @@ fn parse_vec3(text: &str, what: &str) -> Result<[f64; 3]> {
     }
 }
 
+/// `--palm-frame`: the frame link above the hand's root `root`, if asked for.
+fn add_palm_frame(
+    c: &ComposeArgs,
+    robot: &mut tsukami_body::urdf_xml::RawRobot,
+    root: &str,
+) -> Result<()> {
+    let Some(name) = &c.palm_frame else {
+        return Ok(());
+    };
+    let frame = tsukami_body::compose::Frame {
+        name: name.clone(),
+        origin: tsukami_body::urdf_xml::RawPose {
+            xyz: parse_vec3(&c.palm_xyz, "--palm-xyz")?,
+            rpy: parse_vec3(&c.palm_rpy, "--palm-rpy")?,
+        },
+    };
+    tsukami_body::compose::insert_frame(robot, root, &frame)?;
+    Ok(())
+}
+
 /// `tsukami model compose`: reads both files, composes, writes the URDF, and
 /// loads the result for kinematics to prove it is a valid robot.
 fn compose(c: &ComposeArgs) -> Result<()> {
@@ -157,8 +213,9 @@ fn compose(c: &ComposeArgs) -> Result<()> {
         name,
         out,
         load: args,
+        ..
     } = c;
-    use tsukami_body::compose::{compose, read_raw, Attach};
+    use tsukami_body::compose::{compose, read_raw, root_link, Attach};
     let mut raw = Vec::new();
     for file in [arm, hand] {
         let (robot, warnings) = read_raw(file, args.strict)?;
@@ -181,12 +238,14 @@ fn compose(c: &ComposeArgs) -> Result<()> {
     let folder = |p: &Path| p.parent().map(Path::to_path_buf).unwrap_or_default();
     let hand_raw = raw.pop().expect("two files read");
     let arm_raw = raw.pop().expect("two files read");
-    let robot = compose(
+    let hand_root = format!("{prefix}{}", root_link(&hand_raw)?);
+    let mut robot = compose(
         arm_raw,
         hand_raw,
         &attach,
         (&folder(arm), &folder(hand), &out_dir),
     )?;
+    add_palm_frame(c, &mut robot, &hand_root)?;
     let text = tsukami_body::urdf_write::write_urdf(&robot);
     let as_file = out.clone().unwrap_or_else(|| out_dir.join("composed.urdf"));
     let model = tsukami_body::urdf::parse_urdf_with(
@@ -215,10 +274,73 @@ fn compose(c: &ComposeArgs) -> Result<()> {
     Ok(())
 }
 
+/// `tsukami model grasp-types`: the robot description and URDF read as
+/// `inspect` reads them, the first hand resolved, its grasp types derived
+/// (`tsukami_planner_kit::grasp_derive`), checked against the model and written.
+fn grasp_types(robot: &Path, out: Option<&Path>, args: &LoadArgs) -> Result<()> {
+    use tsukami_planner_kit::description::{Description, FILE_NAME};
+    use tsukami_planner_kit::grasp_derive::{derive, to_toml, DeriveOptions};
+    use tsukami_planner_kit::grasp_types::GraspTypeConfig;
+    let file = if robot.is_dir() {
+        robot.join(FILE_NAME)
+    } else {
+        robot.to_path_buf()
+    };
+    let text =
+        std::fs::read_to_string(&file).with_context(|| format!("reading {}", file.display()))?;
+    let description = Description::parse(&text, &file.display().to_string())?;
+    let urdf = file
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join(&description.urdf);
+    let model = load(&urdf, args)?;
+    let spec = &description.hands[0];
+    let empty = GraspTypeConfig {
+        hand: Default::default(),
+        grasp_types: Vec::new(),
+    };
+    let hand = tsukami_planner_kit::Hand::new(&model, spec, 0, empty)?;
+    let derived = derive(&model, &hand, &DeriveOptions::default())?;
+    let mut header = vec![
+        format!(
+            "Grasp types of hand `{}` of robot `{}`, proposed by",
+            spec.name, model.name
+        ),
+        format!("  tsukami model grasp-types {}", robot.display()),
+        "from the hand's kinematics (tsukami_planner_kit::grasp_derive); review and edit.".into(),
+        "Format: docs/grasp-types.md. Palm frame: the description's palm_link.".into(),
+        "Measured (m, palm frame):".into(),
+    ];
+    header.extend(derived.notes.iter().map(|n| format!("  {n}")));
+    let toml_text = to_toml(&derived.config, &header);
+    let again = GraspTypeConfig::parse(&toml_text, "the proposal")?;
+    again.check_against(&model)?;
+    for n in &derived.notes {
+        eprintln!("{n}");
+    }
+    match out {
+        Some(o) => {
+            std::fs::write(o, &toml_text).with_context(|| format!("writing {}", o.display()))?
+        }
+        None => print!("{toml_text}"),
+    }
+    eprintln!(
+        "{} grasp types for hand `{}`",
+        derived.config.grasp_types.len(),
+        spec.name
+    );
+    Ok(())
+}
+
 /// Runs one `tsukami model` subcommand.
 pub fn run(command: &ModelCommand) -> Result<()> {
     match command {
         ModelCommand::Compose(c) => compose(c),
+        ModelCommand::GraspTypes {
+            robot,
+            out,
+            load: args,
+        } => grasp_types(robot, out.as_deref(), args),
         ModelCommand::Inspect { file, load: args } => {
             let model = load(file, args)?;
             print(&report::inspect(&model))
