@@ -65,6 +65,10 @@ pub struct SearchParams {
     pub squat_offset: (f64, f64),
     /// Finger-closing distance threshold (m).
     pub contact_distance: f64,
+    /// A sample below the ellipsoid margin δf is still accepted when the
+    /// exact test finds force closure and the contacts hold this many times
+    /// the weight (the ellipsoid of eq. (10) is an inner approximation).
+    pub exact_safety: f64,
 }
 
 impl Default for SearchParams {
@@ -77,6 +81,7 @@ impl Default for SearchParams {
             finger_offset: 0.12,
             squat_offset: (-0.12, 0.04),
             contact_distance: 0.002,
+            exact_safety: 2.0,
         }
     }
 }
@@ -306,13 +311,14 @@ pub fn search(
         if counters.best_margin.is_none_or(|b| margin > b) {
             counters.best_margin = Some(margin);
         }
-        if margin < p.delta_f {
-            counters.reject(4, None);
-            continue;
-        }
-        // Confirm with the exact friction cones before answering.
+        // Eq. (10)'s margin reached: confirm with the exact friction cones.
+        // Not reached: the ellipsoid is an inner approximation, so the exact
+        // test decides, with the safety factor `exact_safety` on the weight.
         let t_exact = Instant::now();
-        let exact = exact_resists(ctx.object, &grasp);
+        let exact = match margin >= p.delta_f {
+            true => exact_resists(ctx.object, &grasp, 1.0),
+            false => exact_resists(ctx.object, &grasp, p.exact_safety),
+        };
         exact_ms += t_exact.elapsed().as_secs_f64() * 1e3;
         if !exact {
             counters.reject(4, None);
@@ -376,11 +382,12 @@ pub fn ellipsoid_margin(object: &PlanObject, contacts: &[FingerContact]) -> Opti
 }
 
 /// The exact test: the contacts, within circular friction cones and their
-/// force limits, balance the weight.
-pub fn exact_resists(object: &PlanObject, grasp: &Grasp) -> bool {
+/// force limits, balance `safety` times the weight; with `safety > 1` the
+/// grasp must be in force closure as well.
+pub fn exact_resists(object: &PlanObject, grasp: &Grasp, safety: f64) -> bool {
     let weight = grasp.weight_wrench(object.mass, &GRAVITY, &object.center_of_mass);
     exact_test(grasp, ConeModel::Circular, &weight)
-        .map(|t| t.resists_weight())
+        .map(|t| t.weight.weight_scale >= safety && (safety <= 1.0 || t.closure.force_closure))
         .unwrap_or(false)
 }
 

@@ -63,9 +63,12 @@ fn assert_grasp_holds(scene: &str, r: &PlanReply) {
     assert!(verdict.is_ok(), "{scene}: {verdict}");
     let scale = verdict.weight_scale.unwrap();
     assert!(scale >= 1.0, "exact test: weight scale {scale}");
+    // Accepted by eq. (10)'s ellipsoid margin, or, where the ellipsoid (an
+    // inner approximation) says no, by the exact test with twice the weight
+    // (`SearchParams::exact_safety`).
     assert!(
-        r.force_closure.margin >= 0.0,
-        "margin {}",
+        r.force_closure.margin >= 0.0 || scale >= 2.0,
+        "margin {}, weight scale {scale}",
         r.force_closure.margin
     );
     for c in &r.contacts {
