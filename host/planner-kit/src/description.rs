@@ -3,8 +3,9 @@
 //! What: [`Description`], read from `description.toml` beside the URDF (the
 //! role SRDF plays for MoveIt): the URDF file, the hand(s) — palm link, arm and
 //! wrist joints, fingers, the grasp-type file, contact tolerance, finger force
-//! cap — and the joint groups the whole-body fallback adds (`waist`, then
-//! `whole_body`).
+//! cap — the joint groups the whole-body fallback adds (`waist`, then
+//! `whole_body`), and link pairs whose shapes may overlap
+//! (`allowed_collisions`).
 //!
 //! Why: joint and link names used to be constants in the planners and in
 //! `tsukami_body::ik`, and a `[hand]` table in the grasp-type file, so each
@@ -101,6 +102,12 @@ pub struct Description {
     /// Joints it adds last (e.g. the virtual squat joint).
     #[serde(default)]
     pub whole_body: Vec<String>,
+    /// Link pairs never checked for self-collision, beyond the adjacent ones
+    /// (SRDF's `disable_collisions`): for collision models whose shapes
+    /// overlap by construction, e.g. the Allegro hand's thumb base inside its
+    /// palm box. Default none.
+    #[serde(default)]
+    pub allowed_collisions: Vec<[String; 2]>,
 }
 
 impl Description {

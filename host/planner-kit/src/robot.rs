@@ -324,6 +324,11 @@ impl Robot {
             types.hand.touch_allowed = spec.touch_allowed.clone();
             hands.push(Hand::new(&model, spec, i, types)?);
         }
+        for (k, [a, b]) in description.allowed_collisions.iter().enumerate() {
+            let key = format!("allowed_collisions[{k}]");
+            let (a, b) = (link(&model, a, &key)?, link(&model, b, &key)?);
+            hands.iter_mut().for_each(|h| h.collision.allow(a, b));
+        }
         let waist = ids(&model, &description.waist, "waist")?;
         let whole_body = ids(&model, &description.whole_body, "whole_body")?;
         Ok(Robot {
