@@ -35,7 +35,7 @@ use tsukami_body::ik::{IkOptions, IkSolver};
 use tsukami_body::kinematics::{FkState, JointSelection};
 use tsukami_grasp::contact::Contact;
 use tsukami_grasp::ellipsoid::{ellipsoid_test, EllipsoidModel};
-use tsukami_grasp::exact::{exact_test, ConeModel};
+use tsukami_grasp::exact::{exact_force_closure, exact_weight_scale, ConeModel};
 use tsukami_grasp::grasp::Grasp;
 
 use crate::finger_closing::{close_fingers, FingerContact};
@@ -386,9 +386,13 @@ pub fn ellipsoid_margin(object: &PlanObject, contacts: &[FingerContact]) -> Opti
 /// grasp must be in force closure as well.
 pub fn exact_resists(object: &PlanObject, grasp: &Grasp, safety: f64) -> bool {
     let weight = grasp.weight_wrench(object.mass, &GRAVITY, &object.center_of_mass);
-    exact_test(grasp, ConeModel::Circular, &weight)
-        .map(|t| t.weight.weight_scale >= safety && (safety <= 1.0 || t.closure.force_closure))
-        .unwrap_or(false)
+    // The weight program first: most samples that fail, fail it, and the
+    // closure program is then not solved.
+    let holds = exact_weight_scale(grasp, ConeModel::Circular, &weight)
+        .is_ok_and(|w| w.weight_scale >= safety.max(1.0));
+    holds
+        && (safety <= 1.0
+            || exact_force_closure(grasp, ConeModel::Circular).is_ok_and(|c| c.force_closure))
 }
 
 /// Contact point helper for replies.
