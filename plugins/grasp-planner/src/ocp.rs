@@ -18,8 +18,9 @@
 //! determined by the surface: [`OcpParams::preferred_axis`] picks them, so a
 //! can's side faces look toward the robot. Regions: the radius profile of
 //! cross-sections along the longest axis is cut where it jumps and where a
-//! region's radius range grows too wide; similar neighbouring slices are merged
-//! back. Everything is pure over nalgebra values.
+//! region's radius range grows too wide; similar neighbouring runs are merged
+//! back unless the merged run would be that wide again (a vase's flared lip,
+//! its neck and its body stay three regions). Everything is pure over nalgebra values.
 //!
 //! ```
 //! use nalgebra::Point3;
@@ -432,8 +433,19 @@ fn segment_profile(radii: &[f64], params: &OcpParams) -> Vec<std::ops::Range<usi
             }
         }
         if !changed {
+            // Similar neighbours merge unless the merged run would be as
+            // uneven as step 1 cuts (a vase's flared lip and its neck).
+            let even = |a: usize, b: usize| {
+                let r = &radii[a..b];
+                let (lo, hi) = r
+                    .iter()
+                    .fold((f64::INFINITY, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+                hi - lo <= params.range_fraction * hi
+            };
             for i in 0..runs.len().saturating_sub(1) {
-                if (mean(&runs[i]) - mean(&runs[i + 1])).abs() < params.merge_fraction * rmax {
+                if (mean(&runs[i]) - mean(&runs[i + 1])).abs() < params.merge_fraction * rmax
+                    && even(runs[i].start, runs[i + 1].end)
+                {
                     runs[i] = runs[i].start..runs[i + 1].end;
                     runs.remove(i + 1);
                     changed = true;
