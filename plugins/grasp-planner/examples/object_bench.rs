@@ -10,9 +10,10 @@
 //! same can with 1k, 100k and 1M triangles, and their ratios.
 //!
 //! Run in release: `cargo run --release -p tsukami-grasp-planner --example
-//! object_bench [-- --seed N] [--quick] [--sizes] [--only TEXT]` (`--quick`
-//! skips the 1M mesh, `--sizes` runs only the size figures, `--only` the cases
-//! whose object or placement name contains TEXT, with details).
+//! object_bench [-- --seed N] [--quick] [--sizes] [--only TEXT] [--robot NAME]`
+//! (`--quick` skips the 1M mesh, `--sizes` runs only the size figures, `--only`
+//! the cases whose object or placement name contains TEXT, with details,
+//! `--robot` plans with another robot of `models/robots`, e.g. `iiwa_allegro`).
 //! Meshes are written as binary STL files to a temporary model root and loaded
 //! through `set_object` like a user's, then removed.
 
@@ -257,7 +258,13 @@ fn main() {
     let root = std::fs::canonicalize(&tmp).unwrap();
     let planner = Planner::from_config(PlannerConfig::with_roots([models(), root.clone()]))
         .expect("the planner starts");
-    let robot: SetRobot = parse(json!({"robot": "tsukami_humanoid"}));
+    // `--robot NAME`: another robot of `models/robots` (default the humanoid).
+    let robot_name = args
+        .iter()
+        .position(|a| a == "--robot")
+        .and_then(|i| args.get(i + 1))
+        .map_or("tsukami_humanoid", String::as_str);
+    let robot: SetRobot = parse(json!({ "robot": robot_name }));
     planner.set_robot(&robot).unwrap();
 
     let objs = objects();
