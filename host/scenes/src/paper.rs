@@ -95,12 +95,12 @@ pub const PAPER_SCENES: [PaperScene; 5] = [
     },
     PaperScene {
         name: "vase_table",
-        expected: "split into >= 2 regions, a grasp on one",
+        expected: "split into 3 regions (lip, neck, body), a grasp on one",
         style: None,
         approach: Approach::Any,
         squat: Requirement::Any,
         arm_alone_fails: false,
-        min_regions: 2,
+        min_regions: 3,
     },
 ];
 
