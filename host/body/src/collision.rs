@@ -18,7 +18,11 @@
 //! separated from such a mesh, it also tests whether the link lies inside it,
 //! and reports a collision (a negative distance, see [`Proximity`]) if so.
 //! Open meshes stay surfaces; callers that need solids should refuse them
-//! ([`CollisionObject::is_solid`]).
+//! ([`CollisionObject::is_solid`]). A part may instead carry the triangles
+//! around each vertex ([`Part::around`]) and be built without parry's
+//! pseudo-normals: its inside tests then compute the one pseudo-normal they
+//! need ([`crate::mesh_inside`], the same answers), which spares building
+//! all of them — the planner kit's objects do this.
 //!
 //! # Narrow phase
 //! A link part that is a ball or a capsule (the finger phalanges) against an
@@ -45,15 +49,18 @@
 
 use nalgebra::{Isometry3, Point3, Unit, UnitQuaternion, Vector3};
 use parry3d_f64::bounding_volume::Aabb;
-use parry3d_f64::math::Pose;
+use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::{self, ClosestPoints};
 use parry3d_f64::shape::{SharedShape, TriMesh, TriMeshFlags};
+
+use std::sync::Arc;
 
 use crate::capsule_mesh::{self, MeshClosestPoints, SweptSphere};
 use crate::convert::{from_pose, to_point, to_pose, to_vec, to_vector};
 use crate::error::{BodyError, Result};
 use crate::kinematics::FkState;
 use crate::mesh::TriangleMesh;
+use crate::mesh_inside::{self, VertexTriangles};
 use crate::model::{Geometry, LinkId, RobotModel};
 
 /// One shape of a link or object, placed in its owner's frame.
@@ -65,6 +72,11 @@ pub struct Part {
     pub shape: SharedShape,
     /// True for a closed mesh treated as a solid (inside tests enabled).
     pub solid_mesh: bool,
+    /// For a solid mesh built without parry's oriented pseudo-normals: the
+    /// triangles around each vertex, from which its inside tests compute the
+    /// one pseudo-normal they need ([`crate::mesh_inside`], the same answers).
+    /// `None`: parry's own inside test.
+    pub around: Option<Arc<VertexTriangles>>,
 }
 
 impl std::fmt::Debug for Part {
@@ -73,6 +85,7 @@ impl std::fmt::Debug for Part {
             .field("origin", &from_pose(&self.origin))
             .field("shape", &self.shape.shape_type())
             .field("solid_mesh", &self.solid_mesh)
+            .field("around", &self.around.is_some())
             .finish()
     }
 }
@@ -118,7 +131,19 @@ impl Part {
             origin: to_pose(&(origin * extra)),
             shape,
             solid_mesh,
+            around: None,
         })
+    }
+
+    /// Is the world point `p` inside this part placed at `pose` (its owner's
+    /// pose times `origin`)? False for surfaces (`solid_mesh` unset on a mesh).
+    fn contains(&self, pose: &Pose, p: Vector) -> bool {
+        match (&self.around, self.shape.as_trimesh()) {
+            (Some(around), Some(mesh)) => {
+                mesh_inside::contains_local_point(mesh, around, pose.inverse_transform_point(p))
+            }
+            _ => self.shape.contains_point(pose, p),
+        }
     }
 }
 
@@ -225,6 +250,7 @@ impl CollisionObject {
                 origin: Pose::IDENTITY,
                 shape: SharedShape::new(trimesh),
                 solid_mesh: solid,
+                around: None,
             }],
         ))
     }
@@ -419,7 +445,7 @@ fn pair_proximity(
             let d = (a - b).length();
             if d > 1e-12 {
                 let n = Unit::new_normalize(to_vector(a - b));
-                if p2.solid_mesh && p2.shape.contains_point(&w2, a) {
+                if p2.solid_mesh && p2.contains(&w2, a) {
                     // The link is inside the closed mesh.
                     return Some((-d, to_point(a), to_point(b), -n));
                 }
@@ -485,9 +511,8 @@ fn placed_collides(
         return true;
     }
     // A shape wholly inside a closed mesh does not touch its surface.
-    let inside = |a: &Placed, b: &Placed, pb: &Part| {
-        pb.solid_mesh && pb.shape.contains_point(&b.pose, a.aabb.center())
-    };
+    let inside =
+        |a: &Placed, b: &Placed, pb: &Part| pb.solid_mesh && pb.contains(&b.pose, a.aabb.center());
     inside(a, b, p2) || inside(b, a, p1)
 }
 
@@ -501,10 +526,7 @@ fn pair_depth(method: DistanceMethod, pose1: &Pose, p1: &Part, pose2: &Pose, p2:
     }
     let w1 = *pose1 * p1.origin;
     let w2 = *pose2 * p2.origin;
-    let inside = p2.solid_mesh
-        && p2
-            .shape
-            .contains_point(&w2, p1.shape.compute_aabb(&w1).center());
+    let inside = p2.solid_mesh && p2.contains(&w2, p1.shape.compute_aabb(&w1).center());
     // Inside a closed mesh the surface may be far: look that far.
     let reach = if inside {
         let a = p2.shape.compute_aabb(&w2);

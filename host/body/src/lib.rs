@@ -38,6 +38,7 @@ pub mod kinematics;
 pub mod limits;
 pub mod mesh;
 pub mod mesh_clean;
+pub mod mesh_inside;
 pub mod mesh_io;
 pub mod model;
 pub mod object;

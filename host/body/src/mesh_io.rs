@@ -9,8 +9,9 @@
 //! Why: robot collections ship STL, OBJ and Collada (about 30 % of mesh
 //! references in a common collection are `.dae`); objects come as scans.
 //!
-//! How: `mesh-loader` (from the urdf-rs authors) parses all three formats;
-//! for Collada it applies the node transforms and the `<unit meter>` scale
+//! How: a binary STL is read directly (one pass, the same values
+//! `mesh-loader` gives); `mesh-loader` (from the urdf-rs authors) parses
+//! ASCII STL, OBJ and Collada; for Collada it applies the node transforms and the `<unit meter>` scale
 //! (the `up_axis` is ignored, as ROS tools do; node placement is done in
 //! [`crate::collada`]). The file is read through
 //! [`crate::limits::read_bounded`], a Collada file's nesting is checked
@@ -183,6 +184,7 @@ fn parse(path: &Path, bytes: &[u8], format: Format, limits: &ParseLimits) -> Res
                 if n > limits.max_mesh_triangles {
                     return Err(too_many(n));
                 }
+                return Ok(read_binary_stl(bytes, n));
             }
         }
         Format::Collada => {
@@ -225,6 +227,29 @@ fn parse(path: &Path, bytes: &[u8], format: Format, limits: &ParseLimits) -> Res
     })
 }
 
+/// The `n` triangles of a binary STL (see [`binary_stl_triangles`]), three
+/// vertices each in file order: what `mesh-loader` returns for it (the same
+/// values, f32 widened to f64), read in one pass without its normals, colours
+/// and per-triangle copies — the bulk of loading a 100k-triangle scan.
+fn read_binary_stl(bytes: &[u8], n: usize) -> TriangleMesh {
+    let value = |b: &[u8]| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+    let mut vertices = Vec::with_capacity(3 * n);
+    for triangle in bytes[84..].chunks_exact(50).take(n) {
+        // 12 bytes of normal, three corners of 12 bytes, 2 attribute bytes.
+        for corner in triangle[12..48].chunks_exact(12) {
+            vertices.push(Point3::new(
+                value(&corner[0..4]),
+                value(&corner[4..8]),
+                value(&corner[8..12]),
+            ));
+        }
+    }
+    let indices = (0..n as u32)
+        .map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
+        .collect();
+    TriangleMesh { vertices, indices }
+}
+
 /// The parser's message without anything after its first line, so a message
 /// never carries more than a short excerpt of the file.
 fn first_line(e: &std::io::Error) -> String {
@@ -234,11 +259,14 @@ fn first_line(e: &std::io::Error) -> String {
 }
 
 /// The triangle count of a binary STL (header, count, 50 bytes per
-/// triangle), or `None` when the bytes are not one.
+/// triangle), or `None` when the bytes are not one. A text file is never
+/// taken for one: its bytes 80–83 are characters (tab or above), so the count
+/// they spell is at least 0x0909_0909 (151 million triangles, a 7.5 GB
+/// file), and larger counts are refused here.
 fn binary_stl_triangles(bytes: &[u8]) -> Option<usize> {
     let count: [u8; 4] = bytes.get(80..84)?.try_into().ok()?;
     let n = u32::from_le_bytes(count) as usize;
-    (bytes.len() == 84 + 50 * n).then_some(n)
+    (n < 0x0909_0909 && bytes.len() == 84 + 50 * n).then_some(n)
 }
 
 #[cfg(test)]
@@ -269,6 +297,32 @@ mod tests {
             let m = TriangleMesh::load(&p, Vector3::new(-1.0, 1.0, 1.0)).unwrap();
             assert!(m.volume() > 0.0, "{name}");
         }
+    }
+
+    #[test]
+    fn binary_stl_reads_as_mesh_loader_reads_it() {
+        let p = tmp("direct.stl");
+        TriangleMesh::uv_sphere(0.05, 7, 11).write_stl(&p).unwrap();
+        let mut bytes = std::fs::read(&p).unwrap();
+        // Exporters often begin a binary header with "solid".
+        bytes[..12].copy_from_slice(b"solid sphere");
+        let n = binary_stl_triangles(&bytes).unwrap();
+        let direct = read_binary_stl(&bytes, n);
+        let scene = mesh_loader::Loader::default()
+            .merge_meshes(true)
+            .load_stl_from_slice(&bytes, &p)
+            .unwrap();
+        let theirs = mesh_loader::Mesh::merge(scene.meshes);
+        assert_eq!(direct.indices, theirs.faces);
+        let widened: Vec<Point3<f64>> = theirs
+            .vertices
+            .iter()
+            .map(|v| Point3::new(v[0] as f64, v[1] as f64, v[2] as f64))
+            .collect();
+        assert_eq!(direct.vertices, widened);
+        assert_eq!(n, TriangleMesh::uv_sphere(0.05, 7, 11).indices.len());
+        // One byte more or less: not a binary STL by size.
+        assert_eq!(binary_stl_triangles(&bytes[..bytes.len() - 1]), None);
     }
 
     #[test]

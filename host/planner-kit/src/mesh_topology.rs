@@ -27,9 +27,10 @@
 //! cannot be wound consistently (a Möbius-like scan) is used as a surface only,
 //! and the reply says so. Nothing is refused for being untidy.
 //!
-//! How: the edges of all triangles are sorted once (`O(n log n)`, no hash
-//! map), a breadth-first walk over manifold edges assigns flips, and one pass
-//! counts the edge kinds after the flips.
+//! How: the edges of all triangles are sorted once (bucketed by their smaller
+//! vertex, then by the larger one: no hash map), a breadth-first walk over
+//! manifold edges assigns flips, and one pass counts the edge kinds after the
+//! flips.
 //!
 //! ```
 //! use nalgebra::Vector3;
@@ -77,19 +78,49 @@ struct EdgeUse {
     forward: bool,
 }
 
+/// Every edge use, sorted by (edge, triangle): counted into buckets by the
+/// edge's smaller vertex (in triangle order), then each bucket — the few
+/// edges around one vertex — sorted stably by the larger vertex. Linear but
+/// for the buckets' sorts, and no comparison of all 3n uses.
 fn edge_uses(indices: &[[u32; 3]]) -> Vec<EdgeUse> {
-    let mut uses = Vec::with_capacity(indices.len() * 3);
+    let edge = |t: &[u32; 3], e: usize| (t[e], t[(e + 1) % 3]);
+    let n = indices
+        .iter()
+        .flatten()
+        .max()
+        .map_or(0, |&m| m as usize + 1);
+    let mut start = vec![0u32; n + 1];
+    for t in indices {
+        for e in 0..3 {
+            let (a, b) = edge(t, e);
+            start[a.min(b) as usize + 1] += 1;
+        }
+    }
+    for v in 0..n {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start.clone();
+    let blank = EdgeUse {
+        key: 0,
+        tri: 0,
+        forward: false,
+    };
+    let mut uses = vec![blank; indices.len() * 3];
     for (k, t) in indices.iter().enumerate() {
         for e in 0..3 {
-            let (a, b) = (t[e], t[(e + 1) % 3]);
-            uses.push(EdgeUse {
+            let (a, b) = edge(t, e);
+            let slot = &mut fill[a.min(b) as usize];
+            uses[*slot as usize] = EdgeUse {
                 key: (u64::from(a.min(b)) << 32) | u64::from(a.max(b)),
                 tri: k as u32,
                 forward: a < b,
-            });
+            };
+            *slot += 1;
         }
     }
-    uses.sort_unstable_by_key(|u| (u.key, u.tri));
+    for v in 0..n {
+        uses[start[v] as usize..start[v + 1] as usize].sort_by_key(|u| u.key);
+    }
     uses
 }
 

@@ -20,8 +20,11 @@
 //! roots; a mesh path must lie inside them. The default centre of mass is the
 //! centroid of the enclosed volume of a closed mesh (non-manifold ones
 //! included), the convex hull's centroid for an open one, else the box centre.
-//! The collision body is a parry mesh with oriented pseudo-normals whenever the
-//! winding is consistent, so a link inside the object is found.
+//! The collision body is a parry mesh treated as a solid whenever the winding is
+//! consistent, so a link inside the object is found (its inside tests compute
+//! the pseudo-normal they need when asked: `tsukami_body::mesh_inside`).
+
+use std::sync::Arc;
 
 use nalgebra::{Isometry3, Point3, Vector3};
 use parry3d_f64::shape::{SharedShape, TriMesh, TriMeshFlags};
@@ -30,6 +33,7 @@ use tsukami_body::convert::to_vec;
 use tsukami_body::files::FileKind;
 use tsukami_body::limits::ParseLimits;
 use tsukami_body::mesh::TriangleMesh;
+use tsukami_body::mesh_inside::VertexTriangles;
 use tsukami_body::object::ObjectModel;
 use tsukami_msgs::planner::{BoxFace, FaceBlock, ObjectShape, OcpBox, SetObject};
 
@@ -49,6 +53,16 @@ use crate::KitError;
 /// it is built. The host's `max_mesh_bytes` (64 MiB: 1.3M binary-STL
 /// triangles) usually bounds it first.
 pub const MAX_TRIANGLES: usize = 2_000_000;
+
+/// Where and what an object is, beside its mesh (see [`Object::from_mesh`]).
+#[derive(Clone, Copy)]
+struct Placed {
+    pose: Isometry3<f64>,
+    mass: f64,
+    mu: f64,
+    com_local: Option<Point3<f64>>,
+    max_size: f64,
+}
 
 /// A placed, checked object.
 #[derive(Debug, Clone)]
@@ -174,26 +188,28 @@ fn load_model(models: &Models, name: &str) -> Result<(String, TriangleMesh, f64)
     Ok((m.name, m.mesh, m.friction))
 }
 
-/// The collision body of a prepared mesh: oriented pseudo-normals (inside
-/// tests) whenever the winding is consistent, closed or not.
+/// The collision body of a prepared mesh: a solid (inside tests) whenever
+/// the winding is consistent, closed or not. parry's mesh is built without
+/// its oriented pseudo-normals; the inside tests compute the one they need
+/// from the triangles around each vertex (`tsukami_body::mesh_inside`: the
+/// same answers, without hashing every edge at `set_object`).
 pub fn collision_body(
     name: &str,
     pose: Isometry3<f64>,
     mesh: &TriangleMesh,
     topology: &Topology,
 ) -> Result<CollisionObject, String> {
-    let flags = if topology.solid {
-        TriMeshFlags::ORIENTED
-    } else {
-        TriMeshFlags::empty()
-    };
     let vertices = mesh.vertices.iter().map(to_vec).collect();
-    let trimesh = TriMesh::with_flags(vertices, mesh.indices.clone(), flags)
+    let trimesh = TriMesh::with_flags(vertices, mesh.indices.clone(), TriMeshFlags::empty())
         .map_err(|e| format!("cannot build the collision mesh: {e}"))?;
+    let around = topology
+        .solid
+        .then(|| Arc::new(VertexTriangles::new(&mesh.indices, mesh.vertices.len())));
     let part = Part {
         origin: tsukami_body::convert::to_pose(&Isometry3::identity()),
         shape: SharedShape::new(trimesh),
         solid_mesh: topology.solid,
+        around,
     };
     Ok(CollisionObject::new(name, pose, vec![part]))
 }
@@ -226,9 +242,19 @@ impl Object {
             None => None,
         };
         let name = req.name.clone().unwrap_or(name);
-        let mut object = Self::from_mesh(&name, mesh, pose, mass, mu, com, limits.workspace_m)?;
-        object.warnings.splice(0..0, note);
-        Ok(object)
+        let placed = Placed {
+            pose,
+            mass,
+            mu,
+            com_local: com,
+            max_size: limits.workspace_m,
+        };
+        if matches!(req.shape, ObjectShape::Mesh { .. }) {
+            // `load_mesh` cleaned it: cleaning again would change nothing.
+            Self::from_clean_mesh(&name, mesh, note.into_iter().collect(), &placed)
+        } else {
+            Self::from_mesh(&name, mesh, pose, mass, mu, com, limits.workspace_m)
+        }
     }
 
     /// Builds an object from a mesh in its own frame (cleaned here), without
@@ -247,12 +273,37 @@ impl Object {
     ) -> Result<Self, KitError> {
         check_triangles_before_cleaning(&mesh)?;
         let cleanup = mesh.clean();
-        let mut warnings: Vec<String> = cleanup
+        let warnings: Vec<String> = cleanup
             .dropped_any()
             .then(|| format!("mesh cleaned: {}", cleanup.summary()))
             .into_iter()
             .collect();
         check_triangles(&mesh, "shape")?;
+        let placed = Placed {
+            pose,
+            mass,
+            mu,
+            com_local,
+            max_size,
+        };
+        Self::from_clean_mesh(name, mesh, warnings, &placed)
+    }
+
+    /// [`Object::from_mesh`] after cleaning and `check_triangles` (`warnings`
+    /// says what cleaning did).
+    fn from_clean_mesh(
+        name: &str,
+        mut mesh: TriangleMesh,
+        mut warnings: Vec<String>,
+        placed: &Placed,
+    ) -> Result<Self, KitError> {
+        let Placed {
+            pose,
+            mass,
+            mu,
+            com_local,
+            max_size,
+        } = *placed;
         let aabb = mesh.aabb();
         let diagonal = (aabb.1 - aabb.0).norm();
         if !(1e-3..=max_size).contains(&diagonal) {
