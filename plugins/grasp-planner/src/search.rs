@@ -16,9 +16,13 @@
 //! solution), sets the reference posture plus Δa, checks the open hand and arm
 //! against the environment and the object, closes the fingers
 //! ([`crate::finger_closing`]), checks again (contacting links may touch the
-//! object, nothing may touch the environment or the robot itself), then tests
-//! force closure. A grasp that passes the ellipsoid test is confirmed by the
-//! exact friction-cone test (`tsukami-grasp`) before it is returned. The
+//! object, nothing may touch the environment or the robot itself), computes
+//! the ellipsoid margin, checks the returned-grasp guarantees
+//! ([`crate::verify::check_grasp`]) and last runs the exact friction-cone
+//! program (`tsukami-grasp`), the costliest test: a grasp at margin ≥ δf must
+//! hold its weight there; one below δf (the ellipsoid is an inner
+//! approximation) is accepted when it is in exact force closure and holds
+//! [`SearchParams::exact_safety`] times its weight. The
 //! generator is ChaCha8 seeded by the caller: the same seed, same result. The
 //! cancel flag and the deadline are checked before every sample (a sample
 //! takes well under a millisecond).
@@ -311,6 +315,12 @@ pub fn search(
         if counters.best_margin.is_none_or(|b| margin > b) {
             counters.best_margin = Some(margin);
         }
+        // The guarantees of a returned grasp, on the final posture (before
+        // the exact program, the costlier test).
+        if let Err(r) = check_grasp(hand, &fk, &links.moving, object, ctx.env, &contacts) {
+            counters.reject(5, Some(r.label(hand)));
+            continue;
+        }
         // Eq. (10)'s margin reached: confirm with the exact friction cones.
         // Not reached: the ellipsoid is an inner approximation, so the exact
         // test decides, with the safety factor `exact_safety` on the weight.
@@ -322,11 +332,6 @@ pub fn search(
         exact_ms += t_exact.elapsed().as_secs_f64() * 1e3;
         if !exact {
             counters.reject(4, None);
-            continue;
-        }
-        // The guarantees of a returned grasp, on the final posture.
-        if let Err(r) = check_grasp(hand, &fk, &links.moving, object, ctx.env, &contacts) {
-            counters.reject(5, Some(r.label(hand)));
             continue;
         }
         progress(counters);
