@@ -811,8 +811,8 @@ pub fn derive(
         (GraspStyle::Envelope4, 3),
     ];
     for (style, n) in styles {
-        for size in 0..3 {
-            let name = format!("{}_{}", style.as_str(), SIZES[size].1);
+        for (size, (_, label)) in SIZES.iter().enumerate() {
+            let name = format!("{}_{label}", style.as_str());
             if others.len() < n {
                 notes.push(format!("{name}: left out: needs a thumb and {n} fingers"));
                 continue;

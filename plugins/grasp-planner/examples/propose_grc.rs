@@ -8,6 +8,11 @@
 //! width of the finger row along palm y (GRCmin's y edge: the surface the
 //! fingers need), and the centre between them (the GRC position), next to the
 //! values in the file.
+//!
+//! To derive a new hand's grasp types from its kinematics (postures, contacts
+//! and boxes), use `tsukami model grasp-types ROBOT_DIR` instead
+//! (`tsukami_planner_kit::grasp_derive`, `docs/bring-your-own-robot.md`); this
+//! example re-measures the postures of an existing file.
 use nalgebra::Point3;
 use tsukami_body::kinematics::FkState;
 use tsukami_body::model::Geometry;
