@@ -204,3 +204,90 @@ fn schema_command_writes_what_is_committed() {
     }
     assert!(count >= 10);
 }
+
+#[test]
+fn model_compose_declares_a_palm_frame_above_the_hand() {
+    let third = repo().join("tests/data/urdf/third_party");
+    let arm = third.join("pybullet_data/kuka_iiwa/model.urdf");
+    let hand = third
+        .join("example-robot-data/robots/allegro_hand_description/urdf/allegro_right_hand.urdf");
+    let out = tsukami(
+        &[
+            "model",
+            "compose",
+            &arm.display().to_string(),
+            &hand.display().to_string(),
+            "--at",
+            "lbr_iiwa_link_7",
+            "--xyz",
+            "0,0,0.14",
+            "--palm-frame",
+            "palm",
+            "--palm-xyz",
+            "0.0111,0,-0.0475",
+            "--palm-rpy",
+            "0,-1.5707963267948966,3.141592653589793",
+        ],
+        None,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let urdf = String::from_utf8(out.stdout).unwrap();
+    // The arm's flange holds the frame, the frame holds the hand's palm link.
+    assert!(urdf.contains("<parent link=\"lbr_iiwa_link_7\"/>\n    <child link=\"palm\"/>"));
+    assert!(urdf.contains("<parent link=\"palm\"/>\n    <child link=\"palm_link\"/>"));
+    // The same as the committed robot, which was composed this way.
+    let committed =
+        std::fs::read_to_string(repo().join("models/robots/iiwa_allegro/iiwa_allegro.urdf"))
+            .unwrap();
+    let joints = |t: &str| t.matches("<joint ").count();
+    assert_eq!(joints(&urdf), joints(&committed));
+    // A frame name the hand already uses is refused, naming it.
+    let clash = tsukami(
+        &[
+            "model",
+            "compose",
+            &arm.display().to_string(),
+            &hand.display().to_string(),
+            "--at",
+            "lbr_iiwa_link_7",
+            "--palm-frame",
+            "link_0.0",
+        ],
+        None,
+    );
+    assert!(!clash.status.success());
+    assert!(String::from_utf8_lossy(&clash.stderr).contains("link_0.0"));
+}
+
+#[test]
+fn model_grasp_types_proposes_a_file_that_loads_or_names_what_is_missing() {
+    let robot = repo().join("models/robots/iiwa_allegro");
+    let out = tsukami(
+        &["model", "grasp-types", &robot.display().to_string()],
+        None,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let cfg = tsukami_planner_kit::grasp_types::GraspTypeConfig::parse(&text, "proposal").unwrap();
+    assert_eq!(cfg.grasp_types.len(), 9);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("9 grasp types for hand `right`"));
+    // A folder without a description is named in the error.
+    let missing = tsukami(
+        &[
+            "model",
+            "grasp-types",
+            &repo().join("docs").display().to_string(),
+        ],
+        None,
+    );
+    assert!(!missing.status.success());
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("description.toml"));
+}
