@@ -400,7 +400,11 @@ pub struct PlanOptions {
     /// Nominal palm pose criterion.
     #[serde(default)]
     pub palm_criterion: PalmCriterion,
-    /// Required ellipsoid margin δf: stop when `n − f(p1..pn) ≥ δf` (default 0.05).
+    /// Required ellipsoid margin δf: stop when `n − f(p1..pn) ≥ δf`. Absent:
+    /// δf = 0.05, and a sample below it is also accepted when the exact test
+    /// finds force closure holding twice the object's weight (the ellipsoid is
+    /// an inner approximation). Given: the paper's rule alone, the margin is
+    /// required.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub delta_f: Option<f64>,
     /// Restrict the search to these grasp-type names (default: all).

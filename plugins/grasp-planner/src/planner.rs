@@ -173,6 +173,11 @@ impl GraspPlanner for Paper {
         let params = SearchParams {
             max_samples: opts.max_samples,
             delta_f: opts.delta_f.unwrap_or(self.params.search.delta_f),
+            // A requested δf is the paper's rule alone: no exact acceptance below it.
+            exact_safety: match opts.delta_f {
+                Some(_) => f64::INFINITY,
+                None => self.params.search.exact_safety,
+            },
             contact_distance: hand.contact_distance,
             ..self.params.search.clone()
         };

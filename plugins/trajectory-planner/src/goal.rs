@@ -17,9 +17,10 @@
 //! How: the reach joints are the hand's arm, the `joints_used` (each must be one
 //! of the description's waist or whole-body joints), and any other joint the
 //! grasp sets to a value other than the start's. The open hand has every finger's
-//! flex joints at 0 (clamped into their limits), or part way there
-//! ([`Goal::open_by`]); the other hand joints (e.g. the thumb's opposition) are at
-//! their grasp values. The approach direction is the
+//! flex joints at 0 (clamped into their limits) and the grasp type's other
+//! closing joints (e.g. the thumb's opposition) at the type's reference posture,
+//! where the grasp planner started closing them, or part way there
+//! ([`Goal::open_by`]); the remaining hand joints are at their grasp values. The approach direction is the
 //! grasp type's `approach` (palm frame) turned by the palm pose, unless the
 //! request gives one.
 
@@ -49,8 +50,12 @@ pub struct Goal {
     pub closed: Vec<f64>,
     /// The grasp posture, hand open (see [`Goal::open_by`]).
     pub open: Vec<f64>,
-    /// The fingers' flex joints.
-    pub flex: Vec<JointId>,
+    /// The joints that open the hand and their fully open values: the
+    /// fingers' flex joints (straight: 0, clamped into the limits) and the
+    /// grasp type's closing joints that are not flex joints (e.g. a thumb's
+    /// opposition), at the type's reference posture, where the grasp
+    /// planner's closing started.
+    pub flex: Vec<(JointId, f64)>,
     /// The palm pose at the grasp (forward kinematics of `closed`).
     pub palm: Isometry3<f64>,
     /// Unit direction the palm moves in along the approach (world frame).
@@ -251,11 +256,7 @@ pub fn resolve(
         reach,
         hand: hand.joints.clone(),
         open: closed.clone(),
-        flex: hand
-            .fingers
-            .iter()
-            .flat_map(|f| f.flex.iter().copied())
-            .collect(),
+        flex: opening_joints(robot, grasp),
         closed,
         palm,
     };
@@ -268,11 +269,39 @@ impl Goal {
     /// limits; 0: the grasp's angles; linear between).
     pub fn open_by(&mut self, model: &RobotModel, opening: f64) {
         self.open.clone_from(&self.closed);
-        for &j in &self.flex {
-            let lim = model.joints[j].limits;
-            let straight = 0.0f64.clamp(lim.lower, lim.upper);
-            self.open[j] = self.closed[j] + opening * (straight - self.closed[j]);
+        for &(j, open) in &self.flex {
+            self.open[j] = self.closed[j] + opening * (open - self.closed[j]);
         }
         model.apply_mimics(&mut self.open);
     }
+}
+
+/// [`Goal::flex`]: the flex joints straight, then the grasp type's other
+/// closing joints at its reference posture (a type the robot does not know
+/// adds none; [`approach_direction`] names it).
+fn opening_joints(robot: &Robot, grasp: &MotionGrasp) -> Vec<(JointId, f64)> {
+    let (model, hand) = (&robot.model, robot.hand());
+    let mut out: Vec<(JointId, f64)> = hand
+        .fingers
+        .iter()
+        .flat_map(|f| f.flex.iter().copied())
+        .map(|j| {
+            let lim = model.joints[j].limits;
+            (j, 0.0f64.clamp(lim.lower, lim.upper))
+        })
+        .collect();
+    let types = &hand.grasp_types.grasp_types;
+    let Some(g) = types.iter().find(|g| g.name == grasp.grasp_type.name) else {
+        return out;
+    };
+    for c in &g.contacts {
+        let (Ok(j), Some(&v)) = (model.joint_id(&c.joint), g.posture.get(&c.joint)) else {
+            continue;
+        };
+        if !out.iter().any(|&(k, _)| k == j) {
+            let lim = model.joints[j].limits;
+            out.push((j, v.clamp(lim.lower, lim.upper)));
+        }
+    }
+    out
 }
