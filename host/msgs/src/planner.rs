@@ -221,6 +221,9 @@ pub enum FaceBlock {
     Support,
     /// The face lies against another region of the same object.
     Region,
+    /// An obstacle fills the space in front of the face (a wall behind a box,
+    /// the table beside a lying bottle): no hand fits there.
+    Obstacle,
 }
 
 /// One object convex polygon (OCP): an oriented box around one region of the object.

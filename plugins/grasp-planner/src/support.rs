@@ -100,7 +100,10 @@ pub fn block_faces(ocps: &mut [Ocp], env: &[&CollisionObject], probe: &FaceProbe
             };
             let support =
                 ocp.face_normal(face).dot(&-Vector3::z()) > std::f64::consts::FRAC_1_SQRT_2;
-            ocp.blocked[k] = Some(FaceBlock::Support);
+            ocp.blocked[k] = Some(match support {
+                true => FaceBlock::Support,
+                false => FaceBlock::Obstacle,
+            });
             out.push(Blocked {
                 region: ocp.region,
                 face,
