@@ -451,14 +451,68 @@ fn pair_proximity(
                 }
                 return Some((d, to_point(a), to_point(b), n));
             }
-            penetration(&w1, p1, &w2, p2)
+            penetration(method, &w1, p1, &w2, p2)
         }
-        ClosestPoints::Intersecting => penetration(&w1, p1, &w2, p2),
+        ClosestPoints::Intersecting => penetration(method, &w1, p1, &w2, p2),
         ClosestPoints::Disjoint => None,
     }
 }
 
-fn penetration(w1: &Pose, p1: &Part, w2: &Pose, p2: &Part) -> Option<PairProximity> {
+/// A ball or capsule sunk into a mesh surface, in closed form: when its core
+/// segment stays outside the surface at distance `d > 0`, the penetration is
+/// `radius − d` along the core's closest-point direction — what parry's
+/// contact query gives as the deepest of its per-triangle contacts, since a
+/// swept sphere's penetration into a convex triangle is its radius less the
+/// core's distance (without running EPA on every overlapping triangle).
+/// `None` when the fast path does not apply or the core itself touches or
+/// crosses the surface (parry then answers).
+fn fast_penetration(
+    method: DistanceMethod,
+    w1: &Pose,
+    p1: &Part,
+    w2: &Pose,
+    p2: &Part,
+) -> Option<PairProximity> {
+    if method != DistanceMethod::Fast {
+        return None;
+    }
+    let mesh = p2.shape.as_trimesh()?;
+    let sphere = SweptSphere::from_shape(&*p1.shape)?.transformed(&w2.inv_mul(w1));
+    let core = SweptSphere {
+        radius: 0.0,
+        ..sphere
+    };
+    match capsule_mesh::closest_points_to_trimesh(mesh, &core, sphere.radius) {
+        MeshClosestPoints::Separated {
+            distance,
+            on_sphere,
+            on_mesh,
+            ..
+        } if distance > 1e-9 && distance <= sphere.radius => {
+            let dir = (on_sphere - on_mesh) / distance;
+            let deepest = on_sphere - dir * sphere.radius;
+            let n = Unit::new_normalize(to_vector(w2.rotation * dir));
+            Some((
+                distance - sphere.radius,
+                to_point(*w2 * deepest),
+                to_point(*w2 * on_mesh),
+                n,
+            ))
+        }
+        _ => None,
+    }
+}
+
+fn penetration(
+    method: DistanceMethod,
+    w1: &Pose,
+    p1: &Part,
+    w2: &Pose,
+    p2: &Part,
+) -> Option<PairProximity> {
+    if let Some(p) = fast_penetration(method, w1, p1, w2, p2) {
+        return Some(p);
+    }
     match query::contact(w1, &*p1.shape, w2, &*p2.shape, 0.0) {
         Ok(Some(c)) => {
             let n = Unit::try_new(to_vector(c.normal2), 1e-12).unwrap_or(Vector3::z_axis());
