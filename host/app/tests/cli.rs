@@ -291,3 +291,23 @@ fn model_grasp_types_proposes_a_file_that_loads_or_names_what_is_missing() {
     assert!(!missing.status.success());
     assert!(String::from_utf8_lossy(&missing.stderr).contains("description.toml"));
 }
+
+#[test]
+fn a_reader_that_closes_early_ends_the_client_without_a_panic() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::Stdio;
+    // The reader (`| head`) is gone before the client writes: the client ends
+    // as `cat` would, by SIGPIPE, not with "failed printing to stdout".
+    let urdf = humanoid();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tsukami"))
+        .args(["model", "inspect", &urdf])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.signal(), Some(libc::SIGPIPE), "{:?}", out.status);
+}

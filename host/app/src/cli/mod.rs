@@ -147,6 +147,9 @@ enum Command {
 /// Runs the CLI and maps errors to a message and exit status 1.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    if cli.command.prints_and_exits() {
+        die_quietly_on_closed_stdout();
+    }
     // The demo prints its own progress; the host's info lines would only clutter it,
     // as would zenoh's note that its (disabled) scouting found nobody.
     let default_filter = match cli.command {
@@ -168,6 +171,27 @@ pub fn main() -> ExitCode {
             eprintln!("tsukami: {e:#}");
             ExitCode::FAILURE
         }
+    }
+}
+
+impl Command {
+    /// A client command that prints its answer and ends (not the host, the
+    /// router, the demo or the viewer, which serve or supervise).
+    fn prints_and_exits(&self) -> bool {
+        !matches!(
+            self,
+            Command::Run { .. } | Command::Router { .. } | Command::Demo(_) | Command::View(_)
+        )
+    }
+}
+
+/// `tsukami plan … | head` closes stdout early: end as `cat` does (the default
+/// SIGPIPE action) instead of Rust's "failed printing to stdout" panic.
+fn die_quietly_on_closed_stdout() {
+    // SAFETY: setting a signal's disposition to its default before any other
+    // thread exists; no handler runs.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 
