@@ -14,10 +14,11 @@
 //! Why: a planner may be new and wrong; the protocol promises that every grasp
 //! sent was verified. The checks here are the kit's, not the planner's.
 //!
-//! How: checks run in order and the first failure is the reason. **Extension
-//! point:** geometric checks (no link inside the object or an obstacle beyond a
-//! tolerance, contacts on the surface) go in [`geometric_checks`], which runs
-//! before the force-closure step.
+//! How: checks run in order and the first failure is the reason: the shapes,
+//! then [`geometric_checks`] (no link moved by the grasp more than 1 mm inside
+//! the object or an obstacle, contacts on the surface with agreeing normals:
+//! [`crate::blocks::grasp_check`], the same rules the paper's planner applies
+//! to its candidates), then the force-closure step.
 
 use nalgebra::Vector3;
 use tsukami_grasp::contact::Contact;
@@ -25,6 +26,10 @@ use tsukami_grasp::ellipsoid::{ellipsoid_test, EllipsoidModel};
 use tsukami_grasp::exact::{exact_test, ConeModel};
 use tsukami_grasp::grasp::Grasp as GraspMatrix;
 
+use tsukami_body::kinematics::FkState;
+use tsukami_body::model::LinkId;
+
+use crate::blocks::grasp_check::check_in;
 use crate::grasp::{FingerContact, Grasp};
 use crate::object::Object;
 use crate::planner::{GraspPlanner, World};
@@ -115,14 +120,28 @@ fn shape_checks<P: GraspPlanner>(world: &World<'_, P>, grasp: &Grasp) -> Result<
     Ok(())
 }
 
-/// Geometric checks of the grasp on the world (links clear of the object and
-/// the obstacles beyond a tolerance, contacts on the surface). The place for
-/// further checks; none beyond the shape checks yet.
+/// Geometric checks of the grasp on the world
+/// ([`crate::blocks::grasp_check`]): the links the grasp moves — the hand, the
+/// arm and everything below the extra (waist, whole-body) joints — no more
+/// than 1 mm into the object or an obstacle, and every contact on the
+/// object's surface with its normal agreeing.
 pub fn geometric_checks<P: GraspPlanner>(
-    _world: &World<'_, P>,
-    _grasp: &Grasp,
+    world: &World<'_, P>,
+    grasp: &Grasp,
 ) -> Result<(), String> {
-    Ok(())
+    let (model, hand) = (&world.robot.model, world.hand());
+    let mut fk = FkState::new(model);
+    model.forward_kinematics(&grasp.q, &mut fk);
+    let mut links: Vec<LinkId> = hand.links.iter().chain(&hand.arm_links).copied().collect();
+    let mut below: Vec<LinkId> = grasp.extra.iter().map(|&j| model.joints[j].child).collect();
+    while let Some(l) = below.pop() {
+        if !links.contains(&l) {
+            links.push(l);
+        }
+        below.extend(model.links[l].children.iter().copied());
+    }
+    links.retain(|&l| !hand.collision.link_parts(l).is_empty());
+    check_in(world, &fk, &links, &grasp.contacts).map_err(|r| r.describe(model))
 }
 
 /// Verifies `grasp` on `world` (see the module docs); the verdict or why not.

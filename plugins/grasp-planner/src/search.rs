@@ -318,7 +318,7 @@ pub fn search(
         // The guarantees of a returned grasp, on the final posture (before
         // the exact program, the costlier test).
         if let Err(r) = check_grasp(hand, &fk, &links.moving, object, ctx.env, &contacts) {
-            counters.reject(5, Some(r.label(hand)));
+            counters.reject(5, Some(r.label(&hand.robot)));
             continue;
         }
         // Eq. (10)'s margin reached: confirm with the exact friction cones.

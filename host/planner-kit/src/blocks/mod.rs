@@ -6,6 +6,7 @@
 pub mod closing;
 pub mod collision;
 pub mod force;
+pub mod grasp_check;
 pub mod posture;
 pub mod stages;
 pub mod surface;

@@ -28,7 +28,7 @@ use tsukami_body::model::JointId;
 use tsukami_msgs::planner::{GraspSize, GraspStyle, GraspTypeRef, PlanOptions, PlanPhase};
 use tsukami_planner_kit::blocks::collision::{arm_and_hand, first_failure, Pass};
 use tsukami_planner_kit::blocks::stages::{palm_ik, stage_solver, StageSolver};
-use tsukami_planner_kit::blocks::{closing, surface};
+use tsukami_planner_kit::blocks::{closing, grasp_check, surface};
 use tsukami_planner_kit::{verify, FingerContact, Grasp, GraspPlanner, KitError, NoGrasp, Object};
 use tsukami_planner_kit::{PlannerConfig, PlannerInfo, Robot, Run, World};
 
@@ -178,6 +178,10 @@ impl Sample<'_, '_> {
             Pass::SelfCollision,
         ];
         first_failure(hand, &self.fk, &after).map_or(Ok(()), Err)?;
+        // The kit's guarantees (no link 1 mm in, contacts on the surface with
+        // agreeing normals): a sample that fails them is not returned.
+        grasp_check::check_in(w, &self.fk, &links, &contacts)
+            .map_err(|_| "fails the grasp check")?;
         let length = w.object.characteristic_length();
         let v = verify::force_closure(w.object, &contacts, length).ok_or("degenerate contacts")?;
         if !v.exact_resists_weight {
