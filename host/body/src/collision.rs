@@ -296,14 +296,23 @@ impl CollisionObject {
             };
             let point = to_point(world.transform_point(proj.point));
             let distance = (point - p).norm();
-            if !distance.is_finite() || best.is_some_and(|b| b.distance <= distance) {
+            if !distance.is_finite() || best.as_ref().is_some_and(|b| b.distance <= distance) {
                 continue;
             }
+            let on_face = matches!(loc, TrianglePointLocation::OnFace(..));
+            let normals = match on_face {
+                true => vec![n],
+                false => incident_normals(mesh, proj.point),
+            };
             best = Some(SurfacePoint {
                 point,
                 distance,
                 normal: to_vector(world.rotation * n).normalize(),
-                on_face: matches!(loc, TrianglePointLocation::OnFace(..)),
+                on_face,
+                normals: normals
+                    .into_iter()
+                    .map(|m| to_vector(world.rotation * m).normalize())
+                    .collect(),
             });
         }
         best
@@ -334,7 +343,7 @@ impl CollisionObject {
 
 /// The nearest point of an object's mesh surface to a query point, found by
 /// [`CollisionObject::surface_point`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct SurfacePoint {
     /// The point on the surface (world frame).
     pub point: Point3<f64>,
@@ -346,6 +355,26 @@ pub struct SurfacePoint {
     /// True when the point lies inside the triangle, not on an edge or vertex
     /// (where the surface normal is a cone, not one direction).
     pub on_face: bool,
+    /// The unit normals (world frame, as wound) of every triangle holding the
+    /// point: one inside a face, the faces meeting at an edge or a vertex
+    /// otherwise. The surface's normal cone there is spanned by them.
+    pub normals: Vec<Vector3<f64>>,
+}
+
+/// The normals of the triangles of `mesh` whose closest point to `q` (a point
+/// on the mesh, mesh frame) is `q` itself: those meeting at an edge or vertex.
+fn incident_normals(mesh: &TriMesh, q: Vector) -> Vec<Vector> {
+    use parry3d_f64::query::PointQuery;
+    const SAME: f64 = 1e-9;
+    let around = Aabb::new(q - Vector::splat(SAME), q + Vector::splat(SAME));
+    mesh.bvh()
+        .intersect_aabb(&around)
+        .filter_map(|t| {
+            let tri = mesh.triangle(t);
+            let d = (tri.project_local_point(q, false).point - q).length();
+            (d <= SAME).then(|| tri.normal()).flatten()
+        })
+        .collect()
 }
 
 /// Closest points between a link and an object.

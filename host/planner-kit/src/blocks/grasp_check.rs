@@ -7,9 +7,10 @@
 //!   [`PENETRATION_TOLERANCE`] (touching is how a hand holds; sinking in is
 //!   not);
 //! - every contact lies on the object's surface (within [`SURFACE_TOLERANCE`]),
-//!   its link within [`CONTACT_GAP`] of it, and, where it lies inside a
-//!   triangle, its normal within [`NORMAL_TOLERANCE`] of the triangle's
-//!   inward normal.
+//!   its link within [`CONTACT_GAP`] of it, and its normal within
+//!   [`NORMAL_TOLERANCE`] of the surface's normal cone there (the triangle's
+//!   normal inside a face; the cone of the faces meeting at an edge or a
+//!   vertex, as the independent checker has it).
 //!
 //! A failure names the link and what it hit ([`Rejection`]).
 //!
@@ -180,18 +181,67 @@ fn check_contact(
     if gap.is_none() {
         return Err(bad(format!("its link is more than {CONTACT_GAP} m away")));
     }
-    if s.on_face {
-        // Inward normal of the triangle; an open or inconsistently wound mesh
-        // may have it either way round, so compare with the nearer sense.
-        let inward: Vector3<f64> = -s.normal;
-        let cos = c.normal.dot(&inward);
-        let cos = if object.is_solid() { cos } else { cos.abs() };
-        if cos < NORMAL_TOLERANCE.cos() {
-            return Err(bad(format!(
-                "normal {:.1}° from the surface's",
-                cos.clamp(-1.0, 1.0).acos().to_degrees()
-            )));
+    // The contact's outward direction against the surface's normal cone there
+    // (one normal inside a face, the meeting faces' at an edge or a vertex);
+    // an open or inconsistently wound mesh may have its normals either way
+    // round, so its faces are compared in the nearer sense.
+    let out: Vector3<f64> = -c.normal;
+    let angle = match object.is_solid() {
+        true => angle_to_cone(&out, &s.normals),
+        false => {
+            let sense: Vec<Vector3<f64>> =
+                s.normals.iter().map(|n| n * n.dot(&out).signum()).collect();
+            angle_to_cone(&out, &sense)
         }
+    };
+    if angle > NORMAL_TOLERANCE {
+        return Err(bad(format!(
+            "normal {:.1}° from the surface's",
+            angle.to_degrees()
+        )));
     }
     Ok(())
+}
+
+/// Angle (rad) from the unit vector `v` to the cone spanned by the unit
+/// `normals`, or an upper bound of it: the nearest normal, or the nearest
+/// point of a sector between two of them (a vertex's cone is the union of
+/// its pairs' sectors here; the exact cone can only be nearer).
+fn angle_to_cone(v: &Vector3<f64>, normals: &[Vector3<f64>]) -> f64 {
+    let angle = |a: &Vector3<f64>, b: &Vector3<f64>| a.dot(b).clamp(-1.0, 1.0).acos();
+    let mut best = std::f64::consts::PI;
+    for (i, a) in normals.iter().enumerate() {
+        best = best.min(angle(v, a));
+        for b in &normals[i + 1..] {
+            // v projected on the plane of a and b, when it falls between them.
+            let Some(m) = a.cross(b).try_normalize(1e-12) else {
+                continue;
+            };
+            let Some(p) = (v - m * m.dot(v)).try_normalize(1e-12) else {
+                continue;
+            };
+            if a.cross(&p).dot(&m) >= 0.0 && p.cross(b).dot(&m) >= 0.0 {
+                best = best.min(angle(v, &p));
+            }
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_normal_cone_of_an_edge_holds_its_sector() {
+        let (a, b) = (Vector3::x(), Vector3::y());
+        let at = |v: Vector3<f64>| angle_to_cone(&v.normalize(), &[a, b]);
+        assert!(at(Vector3::new(1.0, 1.0, 0.0)) < 1e-12);
+        assert!((at(Vector3::new(1.0, 0.0, 1.0)) - std::f64::consts::FRAC_PI_4).abs() < 1e-12);
+        assert!((at(Vector3::new(1.0, 1.0, 0.1)) - (0.1f64 / 2f64.sqrt()).atan()).abs() < 1e-12);
+        assert!((at(-Vector3::x()) - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        // One face: the angle to its normal.
+        assert!((angle_to_cone(&Vector3::z(), &[a]) - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert_eq!(angle_to_cone(&Vector3::z(), &[]), std::f64::consts::PI);
+    }
 }
