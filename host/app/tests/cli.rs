@@ -297,16 +297,18 @@ fn a_reader_that_closes_early_ends_the_client_without_a_panic() {
     use std::os::unix::process::ExitStatusExt;
     use std::process::Stdio;
     // The reader (`| head`) is gone before the client writes: the client ends
-    // as `cat` would, by SIGPIPE, not with "failed printing to stdout".
+    // as `cat` would, by SIGPIPE, not with "failed printing to stdout". The read
+    // end is closed before the child starts, so no write can ever succeed (a
+    // piped stdout dropped after spawn would race with a fast child).
     let urdf = humanoid();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tsukami"))
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_tsukami"))
         .args(["model", "inspect", &urdf])
-        .stdout(Stdio::piped())
+        .stdout(Stdio::from(writer))
         .stderr(Stdio::piped())
-        .spawn()
+        .output()
         .unwrap();
-    drop(child.stdout.take());
-    let out = child.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_eq!(out.status.signal(), Some(libc::SIGPIPE), "{:?}", out.status);
