@@ -282,7 +282,6 @@ impl CollisionObject {
     /// (`None` when the object has no mesh part or `p` is not finite).
     pub fn surface_point(&self, p: &Point3<f64>) -> Option<SurfacePoint> {
         use parry3d_f64::query::PointQueryWithLocation;
-        use parry3d_f64::shape::TrianglePointLocation;
         let mut best: Option<SurfacePoint> = None;
         for part in &self.parts {
             let Some(mesh) = part.shape.as_trimesh() else {
@@ -290,7 +289,7 @@ impl CollisionObject {
             };
             let world = self.parry_pose * part.origin;
             let local = world.inverse_transform_point(to_vec(p));
-            let (proj, (tri, loc)) = mesh.project_local_point_and_get_location(local, false);
+            let (proj, (tri, _)) = mesh.project_local_point_and_get_location(local, false);
             let Some(n) = mesh.triangle(tri).normal() else {
                 continue;
             };
@@ -299,11 +298,14 @@ impl CollisionObject {
             if !distance.is_finite() || best.as_ref().is_some_and(|b| b.distance <= distance) {
                 continue;
             }
-            let on_face = matches!(loc, TrianglePointLocation::OnFace(..));
-            let normals = match on_face {
-                true => vec![n],
-                false => incident_normals(mesh, proj.point),
-            };
+            // The faces holding the point decide, not the location label: a
+            // point on an edge (a capsule's closest point on a faceted
+            // cylinder) is labelled inside one of its faces as often as not.
+            let mut normals = incident_normals(mesh, proj.point);
+            if normals.is_empty() {
+                normals.push(n);
+            }
+            let on_face = normals.len() == 1;
             best = Some(SurfacePoint {
                 point,
                 distance,
@@ -352,8 +354,9 @@ pub struct SurfacePoint {
     /// The unit normal of the triangle it lies on (world frame), as the
     /// triangle is wound (outward for a closed, consistently wound mesh).
     pub normal: Vector3<f64>,
-    /// True when the point lies inside the triangle, not on an edge or vertex
-    /// (where the surface normal is a cone, not one direction).
+    /// True when the surface has one normal there: inside a face (or on the
+    /// edge between coplanar triangles), not on an edge or vertex where
+    /// faces meet at an angle (where the normal is a cone).
     pub on_face: bool,
     /// The unit normals (world frame, as wound) of every triangle holding the
     /// point: one inside a face, the faces meeting at an edge or a vertex
@@ -362,19 +365,25 @@ pub struct SurfacePoint {
 }
 
 /// The normals of the triangles of `mesh` whose closest point to `q` (a point
-/// on the mesh, mesh frame) is `q` itself: those meeting at an edge or vertex.
+/// on the mesh, mesh frame) is `q` itself, within 0.1 µm: the one face holding
+/// it, or those meeting at an edge or vertex (coplanar ones once).
 fn incident_normals(mesh: &TriMesh, q: Vector) -> Vec<Vector> {
     use parry3d_f64::query::PointQuery;
-    const SAME: f64 = 1e-9;
+    const SAME: f64 = 1e-7;
     let around = Aabb::new(q - Vector::splat(SAME), q + Vector::splat(SAME));
-    mesh.bvh()
-        .intersect_aabb(&around)
-        .filter_map(|t| {
-            let tri = mesh.triangle(t);
-            let d = (tri.project_local_point(q, false).point - q).length();
-            (d <= SAME).then(|| tri.normal()).flatten()
-        })
-        .collect()
+    let mut normals: Vec<Vector> = Vec::new();
+    for t in mesh.bvh().intersect_aabb(&around) {
+        let tri = mesh.triangle(t);
+        let d = (tri.project_local_point(q, false).point - q).length();
+        // Coplanar triangles (a quad's two halves) give one direction.
+        match tri.normal() {
+            Some(n) if d <= SAME && !normals.iter().any(|m| m.dot(n) > 1.0 - 1e-12) => {
+                normals.push(n)
+            }
+            _ => {}
+        }
+    }
+    normals
 }
 
 /// Closest points between a link and an object.

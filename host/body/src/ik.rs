@@ -32,7 +32,11 @@
 //! term `(I − J⁺J) k (q_rest − q)` pulls redundant joints toward the rest pose.
 //! When an attempt stalls, the selected joints restart from a random in-limit
 //! configuration drawn from a ChaCha8 generator seeded by [`IkOptions::seed`];
-//! the result is therefore deterministic for a given seed and input.
+//! the result is therefore deterministic for a given seed and input. Before
+//! any attempt, a target beyond the chain's reach ([`crate::reach`], a bound
+//! that never refuses a reachable one) fails at once with
+//! [`IkSolution::beyond_reach`] set: a whole-body planner's arm-only stage
+//! costs nothing for an object on the floor.
 
 use nalgebra::{Cholesky, Isometry3, Matrix6, Point3, Vector6};
 use rand::{Rng, SeedableRng};
@@ -41,6 +45,7 @@ use rand_chacha::ChaCha8Rng;
 use crate::error::{BodyError, Result};
 use crate::kinematics::{joint_motion, JointSelection};
 use crate::model::{JointId, JointKind, LinkId, RobotModel};
+use crate::reach::ChainReach;
 
 /// Solver settings.
 #[derive(Debug, Clone)]
@@ -93,8 +98,12 @@ pub struct IkSolution {
     pub orientation_error: f64,
     /// Iterations over all attempts.
     pub iterations: usize,
-    /// Attempts used.
+    /// Attempts used (0 when the target is out of reach).
     pub attempts: usize,
+    /// How far (m) the target lies beyond every position the selected joints
+    /// can bring the link to (their limits ignored; [`crate::reach`]); when
+    /// it exceeds the position tolerance no attempt is made. ≤ 0 otherwise.
+    pub beyond_reach: f64,
 }
 
 /// One movable joint on the path to the target link.
@@ -121,6 +130,7 @@ pub struct IkSolver<'m> {
     cols: Vec<Vector6<f64>>,
     lower: Vec<f64>,
     upper: Vec<f64>,
+    reach: ChainReach,
 }
 
 impl<'m> IkSolver<'m> {
@@ -184,6 +194,7 @@ impl<'m> IkSolver<'m> {
             .unzip();
         let n = selection.len();
         let poses = vec![Isometry3::identity(); path.len() + 1];
+        let reach = ChainReach::new(model, &path, movers[0].0);
         Ok(Self {
             model,
             link,
@@ -195,6 +206,7 @@ impl<'m> IkSolver<'m> {
             upper,
             selection,
             options,
+            reach,
         })
     }
 
@@ -256,6 +268,25 @@ impl<'m> IkSolver<'m> {
             0.0
         };
         let target_p = Point3::from(target.translation.vector);
+        let start = self.chain_fk(&q);
+        let beyond_reach = self
+            .reach
+            .beyond(self.model, &self.path, &self.poses, &q, &target_p);
+        if beyond_reach > opts.position_tolerance {
+            self.model.apply_mimics(&mut q);
+            return IkSolution {
+                ok: false,
+                q,
+                position_error: (target_p.coords - start.translation.vector).norm(),
+                orientation_error: match orientation {
+                    true => (target.rotation * start.rotation.inverse()).angle(),
+                    false => 0.0,
+                },
+                iterations: 0,
+                attempts: 0,
+                beyond_reach,
+            };
+        }
         // Best configuration seen so far: (score, position error, orientation error).
         let mut best = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
         let mut best_q = q.clone();
@@ -293,6 +324,7 @@ impl<'m> IkSolver<'m> {
                         orientation_error: oe,
                         iterations,
                         attempts: attempt + 1,
+                        beyond_reach,
                     };
                 }
                 let e = Vector6::new(ep.x, ep.y, ep.z, w_o * eo.x, w_o * eo.y, w_o * eo.z);
@@ -392,6 +424,7 @@ impl<'m> IkSolver<'m> {
             orientation_error: best.2,
             iterations,
             attempts: opts.max_attempts.max(1),
+            beyond_reach,
         }
     }
 

@@ -43,6 +43,7 @@ pub mod mesh_io;
 pub mod model;
 pub mod object;
 pub mod packages;
+pub mod reach;
 pub mod scene;
 pub mod shape_spec;
 pub mod urdf;

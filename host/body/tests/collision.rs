@@ -302,3 +302,50 @@ fn broad_phase_drops_no_colliding_pair() {
         "{pairs} self pairs, {hits} table hits"
     );
 }
+
+#[test]
+fn a_point_on_a_faceted_cylinders_edge_has_both_faces_normals() {
+    // A contact computed on a vertical edge of a 24-sided can lands a
+    // rounding error inside one face as often as not; the surface's normal
+    // cone there is still both faces' (as the independent checker finds it),
+    // not the one face's, 7.5° off the contact normal.
+    let (r, h, n) = (0.033, 0.122, 24);
+    let can = TriangleMesh::cylinder(r, h, n);
+    let object =
+        CollisionObject::from_mesh("can", Isometry3::translation(0.4, -0.2, 0.7), &can).unwrap();
+    let pose = *object.pose();
+    let half = std::f64::consts::PI / n as f64;
+    let mut edges = 0;
+    for v in can.vertices.iter().filter(|v| v.z.abs() < 1e-12) {
+        let theta = v.y.atan2(v.x);
+        if (v.coords.xy().norm() - r).abs() > 1e-9 {
+            continue; // a cap's centre
+        }
+        edges += 1;
+        let tangent = Vector3::new(-theta.sin(), theta.cos(), 0.0);
+        for (z, nudge) in [(0.3, 1e-9), (0.5, -1e-9), (0.7, 0.0)] {
+            let p = pose * (Point3::new(v.x, v.y, z * h) + tangent * nudge);
+            let s = object.surface_point(&p).unwrap();
+            assert!(s.distance < 1e-8, "{}", s.distance);
+            for side in [-half, half] {
+                let face =
+                    pose.rotation * Vector3::new((theta + side).cos(), (theta + side).sin(), 0.0);
+                assert!(
+                    s.normals.iter().any(|m| m.angle(&face) < 1e-6),
+                    "edge at {:.1}°, z {z}: normals {:?} miss the face at {:.1}°",
+                    theta.to_degrees(),
+                    s.normals,
+                    (theta + side).to_degrees()
+                );
+            }
+            assert!(!s.on_face);
+        }
+        // Inside a face, away from its edges: that face's normal alone.
+        let mid = Vector3::new((theta + half).cos(), (theta + half).sin(), 0.0) * r * half.cos();
+        let s = object
+            .surface_point(&(pose * Point3::new(mid.x, mid.y, 0.5 * h)))
+            .unwrap();
+        assert!(s.on_face && s.normals.len() == 1, "{:?}", s.normals);
+    }
+    assert_eq!(edges, n);
+}

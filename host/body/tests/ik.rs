@@ -122,3 +122,103 @@ fn bad_selections_are_errors() {
     let head = JointSelection::from_names(&m, &["head_yaw"]).unwrap();
     assert!(IkSolver::new(&m, m.link_id("r_palm").unwrap(), head, IkOptions::default()).is_err());
 }
+
+/// Random configurations of the selected joints (uniform in their limits, a
+/// quarter of them pushed to a limit, where the reach bound's arcs end) from
+/// a random start of the others: the solver's reach bound never puts the
+/// link's own position beyond reach, and it does refuse targets 0.3 m past
+/// the farthest of them without an attempt.
+fn reach_bound_holds(m: &tsukami_body::RobotModel, link: &str, joints: &[&str], seed: u64) {
+    let link = m.link_id(link).unwrap();
+    let sel = JointSelection::from_names(m, joints).unwrap();
+    let ids = sel.joints.clone();
+    let mut solver = IkSolver::new(m, link, sel, IkOptions::default()).unwrap();
+    let mut rng = common::rng(seed);
+    let mut fk = FkState::new(m);
+    let (mut widest, mut refused) = (f64::NEG_INFINITY, 0);
+    let tries = 2000;
+    for k in 0..tries {
+        let start = common::random_q(m, &mut rng);
+        let mut q = start.clone();
+        let r = common::random_q(m, &mut rng);
+        for (c, &j) in ids.iter().enumerate() {
+            let l = m.joints[j].limits;
+            q[j] = match (k % 4 == 0, (k / 4 + c) % 2 == 0) {
+                (true, true) => l.lower,
+                (true, false) => l.upper,
+                _ => r[j],
+            };
+        }
+        m.apply_mimics(&mut q);
+        m.forward_kinematics(&q, &mut fk);
+        let target = *fk.pose(link);
+        solver.options_mut().max_attempts = 1;
+        solver.options_mut().max_iterations = 1;
+        let sol = solver.solve(&target, false, &start, None);
+        assert!(
+            sol.beyond_reach <= 1e-9,
+            "{joints:?}: a reached position is {} m beyond reach",
+            sol.beyond_reach
+        );
+        widest = widest.max(sol.beyond_reach);
+        // Straight out from the chain's base, well past anything reached.
+        let base = fk.pose(m.joints[ids[0]].parent).translation.vector;
+        let out = target.translation.vector - base;
+        let far = Isometry3::from_parts(
+            Translation3::from(base + out.normalize() * (out.norm() + 2.0)),
+            UnitQuaternion::identity(),
+        );
+        let sol = solver.solve(&far, false, &start, None);
+        if !sol.ok && sol.attempts == 0 && sol.beyond_reach > 0.0 {
+            refused += 1;
+        }
+    }
+    eprintln!("{joints:?}: closest to the bound {widest:.3} m; {refused}/{tries} far targets refused at once");
+    assert_eq!(
+        refused, tries,
+        "{joints:?}: far targets went to the iterations"
+    );
+}
+
+#[test]
+fn the_reach_bound_never_refuses_a_reachable_target() {
+    let m = common::humanoid();
+    let g = common::humanoid_groups();
+    let arm = g.arm.clone();
+    let waist: Vec<&str> = g.waist.iter().chain(&arm).copied().collect();
+    let mut whole = vec![g.squat];
+    whole.extend(&waist);
+    for (seed, joints) in [(1, &arm), (2, &waist), (3, &whole)] {
+        reach_bound_holds(&m, "r_palm", joints, seed);
+    }
+    // A public arm with another hand (different axes, offsets and limits).
+    let iiwa = tsukami_body::urdf::load_urdf(
+        &common::models_dir().join("robots/iiwa_allegro/iiwa_allegro.urdf"),
+    )
+    .unwrap();
+    let joints: Vec<&str> = (1..=7)
+        .map(|i| &*format!("lbr_iiwa_joint_{i}").leak())
+        .collect();
+    reach_bound_holds(&iiwa, "palm", &joints, 4);
+}
+
+#[test]
+fn a_low_target_is_refused_at_once_by_the_arm_and_waist() {
+    // The paper's whole-body fallback: a palm 0.30 m above the floor is out of
+    // the standing arm's and the bending waist's reach (its pitch limit), so
+    // those stages cost no iterations before the squat stage solves it.
+    let m = common::humanoid();
+    let g = common::humanoid_groups();
+    let target = Isometry3::translation(0.40, -0.25, 0.30);
+    let rest = m.rest_positions();
+    let arm = arm_solver(&m, &[]).solve(&target, false, &rest, None);
+    let waist = arm_solver(&m, &g.waist).solve(&target, false, &rest, None);
+    for s in [&arm, &waist] {
+        assert!(!s.ok && s.attempts == 0 && s.beyond_reach > 0.0, "{s:?}");
+    }
+    assert!(waist.beyond_reach < arm.beyond_reach);
+    let mut whole = vec![g.squat];
+    whole.extend(&g.waist);
+    let body = arm_solver(&m, &whole).solve(&target, false, &rest, None);
+    assert!(body.ok && body.beyond_reach <= 0.0, "{body:?}");
+}

@@ -115,6 +115,10 @@ pub struct ExactWeight {
     pub weight_scale: f64,
     /// Contact forces (world frame, N) balancing `weight_scale · w_ext`.
     pub forces: Vec<Vector3<f64>>,
+    /// The program's dual for the balance rows: a wrench-space direction `y`
+    /// whose [`weight_scale_bound`] is `weight_scale` for this grasp, and an
+    /// upper bound of it for any other (a nearby grasp's is often tight).
+    pub certificate: Wrench,
 }
 
 /// Both exact answers for one grasp.
@@ -156,7 +160,11 @@ enum Extra<'a> {
 }
 
 /// Builds and solves one of the two programs; returns `(x, extra*)`.
-fn solve(grasp: &Grasp, cone: ConeModel, extra: Extra<'_>) -> Result<(Vec<f64>, f64), ExactError> {
+fn solve(
+    grasp: &Grasp,
+    cone: ConeModel,
+    extra: Extra<'_>,
+) -> Result<(Vec<f64>, f64, Wrench), ExactError> {
     let n = grasp.len();
     let nv = 3 * n + 1;
     let xe = 3 * n; // index of the extra variable
@@ -261,7 +269,9 @@ fn solve(grasp: &Grasp, cone: ConeModel, extra: Extra<'_>) -> Result<(Vec<f64>, 
         SolverStatus::Solved | SolverStatus::AlmostSolved => {
             let x = solver.solution.x.clone();
             let e = x[xe];
-            Ok((x, e))
+            let z = &solver.solution.z;
+            let dual = Wrench::from_fn(|r, _| z[r]);
+            Ok((x, e, dual))
         }
         other => Err(ExactError::Solver(format!("{other:?}"))),
     }
@@ -270,7 +280,7 @@ fn solve(grasp: &Grasp, cone: ConeModel, extra: Extra<'_>) -> Result<(Vec<f64>, 
 /// Exact force closure with cone model `cone` (see the module docs).
 pub fn exact_force_closure(grasp: &Grasp, cone: ConeModel) -> Result<ExactClosure, ExactError> {
     let grasp_rank = grasp_rank(grasp);
-    let (_, tau) = solve(grasp, cone, Extra::Squeeze)?;
+    let (_, tau, _) = solve(grasp, cone, Extra::Squeeze)?;
     let f_min = grasp
         .force_limits()
         .iter()
@@ -294,7 +304,7 @@ pub fn exact_weight_scale(
     if !external.iter().all(|x| x.is_finite()) {
         return Err(ExactError::BadWrench);
     }
-    let (x, s) = solve(grasp, cone, Extra::Scale(external))?;
+    let (x, s, certificate) = solve(grasp, cone, Extra::Scale(external))?;
     let forces = grasp
         .contacts()
         .iter()
@@ -304,7 +314,35 @@ pub fn exact_weight_scale(
     Ok(ExactWeight {
         weight_scale: s.max(0.0),
         forces,
+        certificate,
     })
+}
+
+/// An upper bound of [`exact_weight_scale`]'s `s*` (circular cones, or the
+/// pyramids inscribed in them) from any wrench-space direction `y`, in a few
+/// flops: weak duality. The balance `Σ G_i f_i = −s·w` gives
+/// `s·(−y·w) = Σ y·G_i f_i ≤ Σ h_i(y)`, where `h_i(y) = f_max,i (g_n +
+/// μ‖g_t‖)⁺` with `g = (G_i U_i)ᵀ y` is the most contact `i`'s truncated cone
+/// can push along `y`; `y` and `−y` are both tried. With the certificate of a
+/// nearby grasp ([`ExactWeight::certificate`]) the bound is often tight, so a
+/// search rejects most grasps that cannot hold the weight without solving
+/// the conic program. `+∞` when neither sign of `y` opposes `w`.
+pub fn weight_scale_bound(grasp: &Grasp, external: &Wrench, y: &Wrench) -> f64 {
+    let mu = grasp.mu();
+    let mut push = [0.0f64; 2];
+    for (c, &f_max) in grasp.contacts().iter().zip(grasp.force_limits()) {
+        let gu = contact_block(c, grasp.reference(), grasp.torque_scale()) * c.frame();
+        let g = gu.transpose() * y;
+        let tangential = g[0].hypot(g[1]);
+        push[0] += f_max * (g[2] + mu * tangential).max(0.0);
+        push[1] += f_max * (-g[2] + mu * tangential).max(0.0);
+    }
+    let yw = y.dot(external);
+    match yw {
+        _ if yw < 0.0 => push[0] / -yw,
+        _ if yw > 0.0 => push[1] / yw,
+        _ => f64::INFINITY,
+    }
 }
 
 /// Both exact programs for one grasp.

@@ -57,3 +57,44 @@ fn exact_agrees_with_ferrari_canny_and_the_inner_ellipsoid_never_lies() {
         s.ellipsoid_weight_inner
     );
 }
+
+#[test]
+fn the_weight_programs_certificate_bounds_every_grasp_and_is_tight_on_its_own() {
+    use rand::{Rng, SeedableRng};
+    use tsukami_grasp::exact::{exact_weight_scale, weight_scale_bound, ConeModel};
+    // Weak duality, checked: the certificate of one grasp's weight program
+    // bounds that grasp's scale exactly and every other grasp's from above,
+    // as does any direction at all.
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x64_75_61_6c);
+    let (mut tight, mut pruned, mut others) = (0, 0, 0);
+    for shape in [common::Shape::Can, common::Shape::Box] {
+        let mut previous: Option<tsukami_grasp::grasp_matrix::Wrench> = None;
+        for i in 0..300 {
+            let g = common::random_grasp(shape, 3 + i % 4, &mut rng);
+            let w = common::weight(&g, shape);
+            let x = exact_weight_scale(&g, ConeModel::Circular, &w).expect("solver");
+            let own = weight_scale_bound(&g, &w, &x.certificate);
+            assert!(
+                (own - x.weight_scale).abs() <= 1e-6 * (1.0 + x.weight_scale),
+                "own certificate {own} vs s* {}",
+                x.weight_scale
+            );
+            tight += 1;
+            let random =
+                tsukami_grasp::grasp_matrix::Wrench::from_fn(|_, _| rng.random_range(-1.0..1.0));
+            for y in previous.iter().chain([&random]) {
+                let b = weight_scale_bound(&g, &w, y);
+                assert!(
+                    b >= x.weight_scale * (1.0 - 1e-9) - 1e-9,
+                    "bound {b} < s* {}",
+                    x.weight_scale
+                );
+                others += 1;
+                pruned += usize::from(b < 1.0);
+            }
+            previous = Some(x.certificate);
+        }
+    }
+    println!("{tight} tight own bounds; {pruned} of {others} other bounds below 1");
+    assert!(pruned > 0);
+}

@@ -39,8 +39,11 @@ use tsukami_body::ik::{IkOptions, IkSolver};
 use tsukami_body::kinematics::{FkState, JointSelection};
 use tsukami_grasp::contact::Contact;
 use tsukami_grasp::ellipsoid::{ellipsoid_test, EllipsoidModel};
-use tsukami_grasp::exact::{exact_force_closure, exact_weight_scale, ConeModel};
+use tsukami_grasp::exact::{
+    exact_force_closure, exact_weight_scale, weight_scale_bound, ConeModel,
+};
 use tsukami_grasp::grasp::Grasp;
+use tsukami_grasp::grasp_matrix::Wrench;
 
 use crate::finger_closing::{close_fingers, FingerContact};
 use crate::hand::HandModel;
@@ -158,6 +161,8 @@ pub struct Counters {
     /// What blocked the collision-rejected samples: `"<link> vs <obstacle>"`
     /// (or `"… vs <link>"` for self-collision) with counts.
     pub blockers: BTreeMap<String, u32>,
+    /// The exact weight program's certificates so far ([`exact_resists`]).
+    pub hints: WeightHints,
 }
 
 impl Counters {
@@ -326,8 +331,8 @@ pub fn search(
         // test decides, with the safety factor `exact_safety` on the weight.
         let t_exact = Instant::now();
         let exact = match margin >= p.delta_f {
-            true => exact_resists(ctx.object, &grasp, 1.0),
-            false => exact_resists(ctx.object, &grasp, p.exact_safety),
+            true => exact_resists(ctx.object, &grasp, 1.0, &mut counters.hints),
+            false => exact_resists(ctx.object, &grasp, p.exact_safety, &mut counters.hints),
         };
         exact_ms += t_exact.elapsed().as_secs_f64() * 1e3;
         if !exact {
@@ -388,16 +393,60 @@ pub fn ellipsoid_margin(object: &PlanObject, contacts: &[FingerContact]) -> Opti
 
 /// The exact test: the contacts, within circular friction cones and their
 /// force limits, balance `safety` times the weight; with `safety > 1` the
-/// grasp must be in force closure as well.
-pub fn exact_resists(object: &PlanObject, grasp: &Grasp, safety: f64) -> bool {
+/// grasp must be in force closure as well. A sample that one of `hints`'
+/// certificates already bounds below the scale it needs is refused without
+/// a program (the bound is exact weak duality: it never refuses one the
+/// program would accept); every program solved adds its certificate.
+pub fn exact_resists(
+    object: &PlanObject,
+    grasp: &Grasp,
+    safety: f64,
+    hints: &mut WeightHints,
+) -> bool {
     let weight = grasp.weight_wrench(object.mass, &GRAVITY, &object.center_of_mass);
+    let needed = safety.max(1.0);
+    if hints.bound(grasp, &weight) < needed {
+        return false;
+    }
     // The weight program first: most samples that fail, fail it, and the
     // closure program is then not solved.
-    let holds = exact_weight_scale(grasp, ConeModel::Circular, &weight)
-        .is_ok_and(|w| w.weight_scale >= safety.max(1.0));
-    holds
+    let Ok(w) = exact_weight_scale(grasp, ConeModel::Circular, &weight) else {
+        return false;
+    };
+    hints.add(w.certificate);
+    w.weight_scale >= needed
         && (safety <= 1.0
             || exact_force_closure(grasp, ConeModel::Circular).is_ok_and(|c| c.force_closure))
+}
+
+/// The weight program's certificates of one plan (the latest
+/// [`WeightHints::KEEP`]): nearby samples share their limiting directions.
+#[derive(Debug, Clone, Default)]
+pub struct WeightHints {
+    certificates: Vec<Wrench>,
+}
+
+impl WeightHints {
+    /// Certificates kept.
+    pub const KEEP: usize = 16;
+
+    /// The least upper bound of the weight scale the certificates give
+    /// (`+∞` without one), minus a relative 1e-9 for the solver's rounding.
+    fn bound(&self, grasp: &Grasp, weight: &Wrench) -> f64 {
+        let b = self
+            .certificates
+            .iter()
+            .map(|y| weight_scale_bound(grasp, weight, y))
+            .fold(f64::INFINITY, f64::min);
+        b * (1.0 + 1e-9)
+    }
+
+    fn add(&mut self, y: Wrench) {
+        if self.certificates.len() == Self::KEEP {
+            self.certificates.remove(0);
+        }
+        self.certificates.push(y);
+    }
 }
 
 /// Contact point helper for replies.

@@ -338,11 +338,15 @@ pub fn ik_batch(model: &RobotModel, requests: &[IkRequest]) -> Result<Vec<IkRepo
             iterations: sol.iterations,
             attempts: sol.attempts,
             link: link_name.to_string(),
-            message: (!sol.ok).then(|| {
-                format!(
-                    "no solution within tolerance after {} attempts (best position error {:.3e} m, orientation error {:.3e} rad)",
-                    sol.attempts, sol.position_error, sol.orientation_error
-                )
+            message: (!sol.ok).then(|| match sol.attempts {
+                0 => format!(
+                    "the target is {:.3} m beyond the reach of the selected joints (no attempt made)",
+                    sol.beyond_reach
+                ),
+                n => format!(
+                    "no solution within tolerance after {n} attempts (best position error {:.3e} m, orientation error {:.3e} rad)",
+                    sol.position_error, sol.orientation_error
+                ),
             }),
         });
     }
