@@ -221,11 +221,16 @@ impl<'m> IkSolver<'m> {
     }
 
     /// Pose of the link for `q`, computed along its chain only (root at the
-    /// identity).
-    fn chain_fk(&mut self, q: &[f64]) -> Isometry3<f64> {
-        let mut pose = Isometry3::identity();
-        self.poses[0] = pose;
-        for (k, &j) in self.path.iter().enumerate() {
+    /// identity), from `path[from]` on: the frames before it are kept from
+    /// the last call (the joints before the first mover do not change
+    /// during a solve, so iterations start there; the same products in the
+    /// same order, so the same bits).
+    fn chain_fk(&mut self, q: &[f64], from: usize) -> Isometry3<f64> {
+        if from == 0 {
+            self.poses[0] = Isometry3::identity();
+        }
+        let mut pose = self.poses[from];
+        for (k, &j) in self.path.iter().enumerate().skip(from) {
             let joint = &self.model.joints[j];
             let value = match &joint.mimic {
                 Some(m) => m.master_multiplier * q[m.master] + m.master_offset,
@@ -268,7 +273,7 @@ impl<'m> IkSolver<'m> {
             0.0
         };
         let target_p = Point3::from(target.translation.vector);
-        let start = self.chain_fk(&q);
+        let start = self.chain_fk(&q, 0);
         let beyond_reach = self
             .reach
             .beyond(self.model, &self.path, &self.poses, &q, &target_p);
@@ -302,7 +307,7 @@ impl<'m> IkSolver<'m> {
             let mut history = f64::INFINITY;
             for it in 0..opts.max_iterations {
                 iterations += 1;
-                let pose = self.chain_fk(&q);
+                let pose = self.chain_fk(&q, self.movers[0].0);
                 let p = Point3::from(pose.translation.vector);
                 let ep = target_p - p;
                 let eo = if orientation {

@@ -18,7 +18,8 @@
 //! How: only obstacle contacts trigger a lift; an arm against the robot
 //! itself (the upper arm in the chest) or against the object triggers the IK
 //! again from other arm postures ([`ARM_STARTS`]), which a lift would not
-//! change. A lift whose IK fails is skipped. The unlifted pose and the usual
+//! change; a hand link on the object triggers neither (the palm pose places
+//! the hand, whatever the arm does). A lift whose IK fails is skipped. The unlifted pose and the usual
 //! IK start are tried first, so a scene whose nominal is already clear is
 //! unchanged.
 //!
@@ -43,7 +44,7 @@ use tsukami_body::ik::IkSolver;
 use tsukami_body::kinematics::FkState;
 
 use crate::hand::HandModel;
-use crate::link_sets::LinkSets;
+use crate::link_sets::{Against, LinkSets};
 use crate::ocp::Ocp;
 
 /// Height step of a lift (m).
@@ -84,15 +85,22 @@ enum Verdict {
     Clear,
     /// A link touches an obstacle (a lift may help).
     Obstacle,
-    /// The arm touches the robot itself, or a link the object (another arm
-    /// posture may help).
+    /// A hand link touches the object where it may not: the hand is where
+    /// the palm pose puts it whatever the arm does, so neither another arm
+    /// posture nor a lift is tried.
+    HandOnObject,
+    /// The arm touches the robot itself or the object (another arm posture
+    /// may help).
     Other,
 }
 
 fn verdict(hand: &HandModel, links: &LinkSets, fk: &FkState, around: &Surroundings<'_>) -> Verdict {
-    match links.blocked(hand, fk, around.object, around.env, true) {
+    match links.blocked_by(hand, fk, around.object, around.env, true) {
         None => Verdict::Clear,
-        Some(_) if links.touches_obstacle(hand, fk, around.env) => Verdict::Obstacle,
+        Some(b) if b.against == Against::Obstacle => Verdict::Obstacle,
+        Some(b) if b.against == Against::Object && hand.hand_links.contains(&b.link) => {
+            Verdict::HandOnObject
+        }
         Some(_) => Verdict::Other,
     }
 }
@@ -233,7 +241,7 @@ pub fn clear_nominal(
             q: q.clone(),
             blocked,
         });
-        if v == Verdict::Other {
+        if matches!(v, Verdict::Other | Verdict::HandOnObject) {
             return first;
         }
         highest = Some((p, q));

@@ -94,18 +94,6 @@ impl LinkSets {
         }
     }
 
-    /// Whether a moving link touches an obstacle in the posture of `fk`.
-    pub fn touches_obstacle(
-        &self,
-        hand: &HandModel,
-        fk: &FkState,
-        env: &[&CollisionObject],
-    ) -> bool {
-        hand.collision
-            .first_collision(fk, &self.moving, env, 0.0)
-            .is_some()
-    }
-
     /// What blocks the posture in `fk`, as `"<link> vs <what>"`: a link
     /// touching an obstacle, a link that may not touch the object touching
     /// it, a touching link sinking into it, or (`self_check`) two links.
@@ -117,23 +105,70 @@ impl LinkSets {
         env: &[&CollisionObject],
         self_check: bool,
     ) -> Option<String> {
+        self.blocked_by(hand, fk, object, env, self_check)
+            .map(|b| b.text)
+    }
+
+    /// [`LinkSets::blocked`] with the offending link and what it meets.
+    pub fn blocked_by(
+        &self,
+        hand: &HandModel,
+        fk: &FkState,
+        object: &CollisionObject,
+        env: &[&CollisionObject],
+        self_check: bool,
+    ) -> Option<Blocked> {
         let c = &hand.collision;
         let name = |l: LinkId| hand.robot.links[l].name.as_str();
+        let block = |link: LinkId, against: Against, text: String| Blocked {
+            link,
+            against,
+            text,
+        };
         if let Some(h) = c.first_collision(fk, &self.moving, env, 0.0) {
-            return Some(format!("{} vs {}", name(h.link), env[h.object].name));
+            let text = format!("{} vs {}", name(h.link), env[h.object].name);
+            return Some(block(h.link, Against::Obstacle, text));
         }
         if let Some(h) = c.first_collision(fk, &self.not_touching, &[object], 0.0) {
-            return Some(format!("{} vs the object", name(h.link)));
+            let text = format!("{} vs the object", name(h.link));
+            return Some(block(h.link, Against::Object, text));
         }
         let tol = 0.5 * PENETRATION_TOLERANCE;
         if let Some(p) = c.first_penetration(fk, &self.touching, &[object], tol) {
-            return Some(format!("{} into the object", name(p.link)));
+            let text = format!("{} into the object", name(p.link));
+            return Some(block(p.link, Against::Object, text));
         }
         if self_check {
             if let Some((a, b)) = c.first_self_collision(fk, 0.0) {
-                return Some(format!("{} vs {}", name(a), name(b)));
+                return Some(block(
+                    a,
+                    Against::Robot,
+                    format!("{} vs {}", name(a), name(b)),
+                ));
             }
         }
         None
     }
+}
+
+/// What a link of a blocked posture meets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Against {
+    /// An obstacle.
+    Obstacle,
+    /// The object, where the link may not touch it or sinks in too deep.
+    Object,
+    /// Another link of the robot.
+    Robot,
+}
+
+/// The first violation of a posture ([`LinkSets::blocked_by`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Blocked {
+    /// The offending link.
+    pub link: LinkId,
+    /// What it meets.
+    pub against: Against,
+    /// `"<link> vs <what>"`.
+    pub text: String,
 }
