@@ -145,6 +145,20 @@ impl Part {
             _ => self.shape.contains_point(pose, p),
         }
     }
+
+    /// [`Part::contains`] for a point whose nearest triangle of this mesh
+    /// part is known (`nearest`, from a closest-point query).
+    fn contains_near(&self, pose: &Pose, p: Vector, nearest: Option<u32>) -> bool {
+        match (&self.around, self.shape.as_trimesh(), nearest) {
+            (Some(around), Some(mesh), Some(t)) => mesh_inside::contains_local_point_near(
+                mesh,
+                around,
+                pose.inverse_transform_point(p),
+                t,
+            ),
+            _ => self.contains(pose, p),
+        }
+    }
 }
 
 /// Builds a parry mesh (with its BVH); closed meshes get oriented
@@ -433,6 +447,19 @@ fn fast_closest_points(
     p2: &Part,
     max_distance: f64,
 ) -> Option<ClosestPoints> {
+    fast_closest_triangle(method, w1, p1, w2, p2, max_distance).map(|(cp, _)| cp)
+}
+
+/// [`fast_closest_points`] with the index of the mesh triangle holding the
+/// witness point on the mesh, when separated.
+fn fast_closest_triangle(
+    method: DistanceMethod,
+    w1: &Pose,
+    p1: &Part,
+    w2: &Pose,
+    p2: &Part,
+    max_distance: f64,
+) -> Option<(ClosestPoints, Option<u32>)> {
     if method != DistanceMethod::Fast {
         return None;
     }
@@ -443,10 +470,16 @@ fn fast_closest_points(
     Some(
         match capsule_mesh::closest_points_to_trimesh(mesh, &sphere, max_distance) {
             MeshClosestPoints::Separated {
-                on_sphere, on_mesh, ..
-            } => ClosestPoints::WithinMargin(*w2 * on_sphere, *w2 * on_mesh),
-            MeshClosestPoints::Intersecting => ClosestPoints::Intersecting,
-            MeshClosestPoints::Disjoint => ClosestPoints::Disjoint,
+                on_sphere,
+                on_mesh,
+                triangle,
+                ..
+            } => (
+                ClosestPoints::WithinMargin(*w2 * on_sphere, *w2 * on_mesh),
+                Some(triangle),
+            ),
+            MeshClosestPoints::Intersecting => (ClosestPoints::Intersecting, None),
+            MeshClosestPoints::Disjoint => (ClosestPoints::Disjoint, None),
         },
     )
 }
@@ -477,13 +510,22 @@ fn pair_proximity(
 ) -> Option<PairProximity> {
     let w1 = *pose1 * p1.origin;
     let w2 = *pose2 * p2.origin;
-    let cp = closest_points(method, &w1, p1, &w2, p2, max_distance)?;
+    // The fast path knows the mesh triangle nearest the link: the inside
+    // test then needs no search of its own (the link's witness point has
+    // the mesh's witness point as its nearest surface point).
+    let (cp, nearest) = match fast_closest_triangle(method, &w1, p1, &w2, p2, max_distance) {
+        Some(found) => found,
+        None => (
+            closest_points(method, &w1, p1, &w2, p2, max_distance)?,
+            None,
+        ),
+    };
     match cp {
         ClosestPoints::WithinMargin(a, b) => {
             let d = (a - b).length();
             if d > 1e-12 {
                 let n = Unit::new_normalize(to_vector(a - b));
-                if p2.solid_mesh && p2.contains(&w2, a) {
+                if p2.solid_mesh && p2.contains_near(&w2, a, nearest) {
                     // The link is inside the closed mesh.
                     return Some((-d, to_point(a), to_point(b), -n));
                 }

@@ -147,7 +147,17 @@ impl RobotModel {
     pub fn forward_kinematics(&self, q: &[f64], fk: &mut FkState) {
         debug_assert_eq!(q.len(), self.joints.len());
         fk.poses[0] = fk.base;
-        for (j, joint) in self.joints.iter().enumerate() {
+        self.forward_kinematics_from(q, fk, 0);
+    }
+
+    /// [`RobotModel::forward_kinematics`] for the joints from `first` on,
+    /// when only they changed since `fk` was last computed for `q`: joints
+    /// are numbered parents first, so the poses before `first` stand (the
+    /// same products as a full pass, so the same bits). A finger closing
+    /// moves one joint of the hand, near the end of the list.
+    pub fn forward_kinematics_from(&self, q: &[f64], fk: &mut FkState, first: JointId) {
+        debug_assert_eq!(q.len(), self.joints.len());
+        for (j, joint) in self.joints.iter().enumerate().skip(first) {
             let value = match &joint.mimic {
                 Some(m) => m.master_multiplier * q[m.master] + m.master_offset,
                 None => q[j],

@@ -103,6 +103,39 @@ pub fn contains_local_point(mesh: &TriMesh, around: &VertexTriangles, point: Vec
     else {
         return false;
     };
+    behind_pseudo_normal(mesh, around, point, proj.point, tri, location)
+}
+
+/// [`contains_local_point`] when the triangle nearest `point` is known (a
+/// closest-point query just found it): the point is projected on that
+/// triangle alone, without the mesh-wide search. The answer is the same
+/// for a point off the surface (at a tie between triangles the feature they
+/// share has one pseudo-normal).
+pub fn contains_local_point_near(
+    mesh: &TriMesh,
+    around: &VertexTriangles,
+    point: Vector,
+    nearest: u32,
+) -> bool {
+    if nearest as usize >= mesh.indices().len() {
+        return contains_local_point(mesh, around, point);
+    }
+    let (proj, location) = mesh
+        .triangle(nearest)
+        .project_local_point_and_get_location(point, false);
+    behind_pseudo_normal(mesh, around, point, proj.point, nearest, location)
+}
+
+/// Does `point`, whose projection on triangle `tri` is `proj` at `location`,
+/// lie behind the mesh's pseudo-normal there?
+fn behind_pseudo_normal(
+    mesh: &TriMesh,
+    around: &VertexTriangles,
+    point: Vector,
+    proj: Vector,
+    tri: u32,
+    location: TrianglePointLocation,
+) -> bool {
     let idx = mesh.indices()[tri as usize];
     let normal = match location {
         TrianglePointLocation::OnFace(..) | TrianglePointLocation::OnSolid => {
@@ -114,7 +147,7 @@ pub fn contains_local_point(mesh: &TriMesh, around: &VertexTriangles, point: Vec
         }
         TrianglePointLocation::OnVertex(i) => vertex_pseudo_normal(mesh, around, idx[i as usize]),
     };
-    (point - proj.point).dot(normal) <= 0.0
+    (point - proj).dot(normal) <= 0.0
 }
 
 /// The sum of the unit normals of the triangles having edge `a`–`b`.
@@ -193,6 +226,17 @@ mod tests {
         out
     }
 
+    /// [`contains_local_point_near`] with the nearest triangle found by
+    /// brute force, the last of equals (not the BVH's pick at a tie).
+    fn near(mesh: &TriMesh, around: &VertexTriangles, p: Vector) -> bool {
+        use parry3d_f64::query::PointQuery;
+        let d = |t: u32| (mesh.triangle(t).project_local_point(p, false).point - p).length();
+        let nearest = (0..mesh.indices().len() as u32)
+            .min_by(|&a, &b| d(a).total_cmp(&d(b)).then(b.cmp(&a)))
+            .unwrap();
+        contains_local_point_near(mesh, around, p, nearest)
+    }
+
     #[test]
     fn answers_match_parrys_oriented_mesh_bit_for_bit() {
         let mut mug = TriangleMesh::cuboid(Vector3::new(0.0625, 0.0625, 0.125));
@@ -219,6 +263,7 @@ mod tests {
             for p in probes(crate::convert::to_vec(&lo), crate::convert::to_vec(&hi)) {
                 let want = oriented.contains_local_point(p);
                 assert_eq!(contains_local_point(&plain, &around, p), want, "{p:?}");
+                assert_eq!(near(&plain, &around, p), want, "{p:?}");
                 inside += usize::from(want);
                 outside += usize::from(!want);
             }
@@ -232,6 +277,7 @@ mod tests {
                         let p = mid * s;
                         let want = oriented.contains_local_point(p);
                         assert_eq!(contains_local_point(&plain, &around, p), want, "{p:?}");
+                        assert_eq!(near(&plain, &around, p), want, "{p:?}");
                     }
                 }
             }

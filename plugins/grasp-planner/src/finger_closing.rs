@@ -93,6 +93,16 @@ pub fn moved_links(hand: &HandModel, joint: JointId, first: LinkId) -> Vec<LinkI
     out
 }
 
+/// How many steps, each moving the links by at most `per_step`, certainly
+/// leave links now `distance` away farther than `range` (0 when none).
+fn far_steps(distance: f64, range: f64, per_step: f64) -> usize {
+    let k = ((distance - range) / per_step * (1.0 - 1e-9)).floor();
+    match k.is_finite() && k > 0.0 && per_step > 0.0 {
+        true => k.min(1e6) as usize,
+        false => 0,
+    }
+}
+
 /// Farthest a link–object query looks (m): a finger whose links are all
 /// farther than this when closing starts fails, as it cannot be near a grasp.
 const MAX_QUERY: f64 = 0.2;
@@ -104,6 +114,9 @@ struct Closing<'a> {
     c: &'a ResolvedContact,
     links: Vec<LinkId>,
     object: &'a CollisionObject,
+    /// The first joint whose pose a step changes: the closing joint or a
+    /// joint mimicking it (forward kinematics restarts there).
+    first_joint: JointId,
     /// Query range during steps: a step moves no point of `links` by more
     /// than `speed · step` ([`closing_speed`]), so a link that was outside by
     /// at least the threshold is, after the step, either farther than this
@@ -126,7 +139,9 @@ impl Closing<'_> {
     ) -> Option<(LinkId, Proximity)> {
         q[self.c.joint] = angle;
         self.hand.robot.apply_mimics(q);
-        self.hand.robot.forward_kinematics(q, fk);
+        self.hand
+            .robot
+            .forward_kinematics_from(q, fk, self.first_joint);
         self.links
             .iter()
             .filter_map(|&l| {
@@ -181,18 +196,35 @@ fn close_one(
     step: f64,
 ) -> Option<FingerContact> {
     let speed = closing_speed(&hand.robot, &hand.collision, c.joint);
+    let robot = &hand.robot;
+    let first_joint = (0..robot.joints.len())
+        .find(|&j| {
+            j == c.joint
+                || robot.joints[j]
+                    .mimic
+                    .as_ref()
+                    .is_some_and(|m| m.master == c.joint)
+        })
+        .unwrap_or(c.joint);
     let closing = Closing {
         hand,
         c,
         links: moved_links(hand, c.joint, c.link),
         object,
+        first_joint,
         reach: (speed * step + threshold).min(MAX_QUERY),
     };
+    // `fk` matches `q` from here on, but for the joints a step moves.
+    robot.forward_kinematics(q, fk);
     let mut prev = q[c.joint];
     let first = closing.at(q, fk, prev, MAX_QUERY)?;
     if first.1.distance < 0.0 {
         return None; // starts inside the object
     }
+    // Steps that cannot bring any link within the query range of the
+    // first distance (each moves a point by at most `speed · step`): their
+    // queries would find nothing, so they are not made.
+    let mut skip = far_steps(first.1.distance, closing.reach, speed * step);
     let mut near = Some(first);
     let mut angle = prev;
     // At most one turn, even for a joint without an upper limit.
@@ -208,6 +240,11 @@ fn close_one(
         }
         prev = angle;
         angle = (angle + step).min(upper);
+        if skip > 0 {
+            skip -= 1;
+            near = None;
+            continue;
+        }
         near = closing.at(q, fk, angle, closing.reach);
     };
     // Overshot into the object: bisect the last step.

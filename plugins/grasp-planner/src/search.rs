@@ -320,20 +320,26 @@ pub fn search(
         if counters.best_margin.is_none_or(|b| margin > b) {
             counters.best_margin = Some(margin);
         }
-        // The guarantees of a returned grasp, on the final posture (before
-        // the exact program, the costlier test).
+        // Eq. (10)'s margin reached: the exact friction cones must confirm
+        // it. Not reached: the ellipsoid is an inner approximation, so the
+        // exact test decides, with the safety factor `exact_safety` on the
+        // weight. A certificate of an earlier sample may already rule the
+        // sample out (cheap); then the guarantees of a returned grasp, on the
+        // final posture; then the exact programs, the costliest test.
+        let safety = match margin >= p.delta_f {
+            true => 1.0,
+            false => p.exact_safety,
+        };
+        if counters.hints.rule_out(ctx.object, &grasp, safety) {
+            counters.reject(4, None);
+            continue;
+        }
         if let Err(r) = check_grasp(hand, &fk, &links.moving, object, ctx.env, &contacts) {
             counters.reject(5, Some(r.label(&hand.robot)));
             continue;
         }
-        // Eq. (10)'s margin reached: confirm with the exact friction cones.
-        // Not reached: the ellipsoid is an inner approximation, so the exact
-        // test decides, with the safety factor `exact_safety` on the weight.
         let t_exact = Instant::now();
-        let exact = match margin >= p.delta_f {
-            true => exact_resists(ctx.object, &grasp, 1.0, &mut counters.hints),
-            false => exact_resists(ctx.object, &grasp, p.exact_safety, &mut counters.hints),
-        };
+        let exact = exact_resists(ctx.object, &grasp, safety, &mut counters.hints);
         exact_ms += t_exact.elapsed().as_secs_f64() * 1e3;
         if !exact {
             counters.reject(4, None);
@@ -403,18 +409,17 @@ pub fn exact_resists(
     safety: f64,
     hints: &mut WeightHints,
 ) -> bool {
-    let weight = grasp.weight_wrench(object.mass, &GRAVITY, &object.center_of_mass);
-    let needed = safety.max(1.0);
-    if hints.bound(grasp, &weight) < needed {
+    if hints.rule_out(object, grasp, safety) {
         return false;
     }
     // The weight program first: most samples that fail, fail it, and the
     // closure program is then not solved.
+    let weight = grasp.weight_wrench(object.mass, &GRAVITY, &object.center_of_mass);
     let Ok(w) = exact_weight_scale(grasp, ConeModel::Circular, &weight) else {
         return false;
     };
     hints.add(w.certificate);
-    w.weight_scale >= needed
+    w.weight_scale >= safety.max(1.0)
         && (safety <= 1.0
             || exact_force_closure(grasp, ConeModel::Circular).is_ok_and(|c| c.force_closure))
 }
@@ -430,15 +435,20 @@ impl WeightHints {
     /// Certificates kept.
     pub const KEEP: usize = 16;
 
-    /// The least upper bound of the weight scale the certificates give
-    /// (`+∞` without one), minus a relative 1e-9 for the solver's rounding.
-    fn bound(&self, grasp: &Grasp, weight: &Wrench) -> f64 {
-        let b = self
+    /// Whether a certificate bounds the weight scale of `grasp` on `object`
+    /// below `safety` (at least 1): the weight program would refuse it.
+    /// A relative 1e-9 is left for the solver's rounding.
+    pub fn rule_out(&self, object: &PlanObject, grasp: &Grasp, safety: f64) -> bool {
+        if self.certificates.is_empty() {
+            return false;
+        }
+        let weight = grasp.weight_wrench(object.mass, &GRAVITY, &object.center_of_mass);
+        let bound = self
             .certificates
             .iter()
-            .map(|y| weight_scale_bound(grasp, weight, y))
+            .map(|y| weight_scale_bound(grasp, &weight, y))
             .fold(f64::INFINITY, f64::min);
-        b * (1.0 + 1e-9)
+        bound * (1.0 + 1e-9) < safety.max(1.0)
     }
 
     fn add(&mut self, y: Wrench) {
