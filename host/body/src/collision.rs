@@ -140,7 +140,10 @@ impl Part {
     fn contains(&self, pose: &Pose, p: Vector) -> bool {
         match (&self.around, self.shape.as_trimesh()) {
             (Some(around), Some(mesh)) => {
-                mesh_inside::contains_local_point(mesh, around, pose.inverse_transform_point(p))
+                let local = pose.inverse_transform_point(p);
+                // Outside the mesh's box is outside the mesh: no search.
+                mesh.local_aabb().contains_local_point(local)
+                    && mesh_inside::contains_local_point(mesh, around, local)
             }
             _ => self.shape.contains_point(pose, p),
         }

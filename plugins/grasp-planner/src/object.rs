@@ -89,6 +89,8 @@ pub struct PlanObject {
     pub collision: CollisionObject,
     /// Largest OCP edge (m): the characteristic length of wrenches (γ = 1 / length).
     pub characteristic_length: f64,
+    /// Height of the lowest vertex (m, world): where a support under it is.
+    pub lowest: f64,
 }
 
 impl PlanObject {
@@ -129,11 +131,12 @@ impl PlanObject {
             mu: o.mu,
             pose: o.pose,
             center_of_mass: o.center_of_mass,
-            vertices,
             triangles: o.mesh.indices.clone(),
             ocps,
             collision: o.collision.clone(),
             characteristic_length,
+            lowest: vertices.iter().map(|v| v.z).fold(f64::INFINITY, f64::min),
+            vertices,
         })
     }
 }

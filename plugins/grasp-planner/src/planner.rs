@@ -152,13 +152,7 @@ impl GraspPlanner for Paper {
         let floor = ocps
             .iter()
             .any(|o| o.blocked.iter().flatten().any(|b| *b == FaceBlock::Support))
-            .then(|| {
-                object
-                    .vertices
-                    .iter()
-                    .map(|v| v.z)
-                    .fold(f64::INFINITY, f64::min)
-            });
+            .then_some(object.lowest);
         let mut selection = select(&types, &ocps, object.mass);
         for c in selection
             .candidates
