@@ -1,16 +1,23 @@
-//! Time to plan each of the paper's scenes, p50 over seeds, in-process (the planner
-//! library called directly) and over the bus (a client → the host → the plugin file),
-//! in the same run, with the ratio.
+//! Time to plan each of the paper's scenes, p50 over seeds, in-process (the plugin
+//! file cargo built, loaded into this process and called through its FFI with a
+//! recording host: no bus) and over the bus (a client → the host → the same plugin
+//! file), in the same run, with the ratio. (Linking the planner's library here
+//! instead would put two plugins' root-module exports in one binary: the host's
+//! picture code links the result viewer's.)
 //!
 //! Run: `cargo bench -p tsukami-e2e --bench plan_scenes`. Targets (issue #5): can at
 //! breast height p50 < 10 ms in-process; fridge scene p50 < 100 ms.
 
+use abi_stable::sabi_trait::TD_Opaque;
+use abi_stable::std_types::RArc;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
-use tsukami_e2e::{models_dir, planner_entry, test_config, TestBus};
-use tsukami_grasp_planner::planner::Planner;
+use tsukami_e2e::{models_dir, planner_entry, plugin_file, test_config, TestBus};
 use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER};
 use tsukami_msgs::planner::PlanOptions;
+use tsukami_plugin_api::ffi::FfiHost_TO;
+use tsukami_plugin_api::loader::{LoadedLibrary, PluginInstance};
+use tsukami_plugin_api::offline::OfflineHost;
 use tsukami_scenes::{scene_requests, PAPER_SCENES};
 
 const SEEDS: u64 = 32;
@@ -21,8 +28,17 @@ fn median_ms(mut times: Vec<Duration>) -> f64 {
     times[times.len() / 2].as_secs_f64() * 1e3
 }
 
+/// The planner's plugin file, loaded here with the repository's models.
+fn in_process_planner() -> PluginInstance {
+    let library = LoadedLibrary::load(&plugin_file("tsukami_grasp_planner")).expect("loads");
+    let config = format!("models_dir = {:?}\n", models_dir().display().to_string());
+    let host = FfiHost_TO::from_ptr(RArc::new(OfflineHost::new()), TD_Opaque);
+    library.create(host, &config).expect("the planner starts")
+}
+
 fn main() {
     let bus = TestBus::start(test_config(vec![planner_entry()]));
+    let local = in_process_planner();
     let send = |command: &str, body: Vec<u8>| {
         bus.client
             .command(ROLE_GRASP_PLANNER, command, &body, T)
@@ -42,20 +58,26 @@ fn main() {
         )
         .unwrap();
 
-        let mut local = Planner::new(models_dir());
-        local.set_robot(&req.robot).unwrap();
-        local.set_object(&req.object).unwrap();
-        local.set_env(&req.env).unwrap();
+        let call = |command: &str, body: Vec<u8>| {
+            local
+                .call(command, &body, &AtomicBool::new(false))
+                .unwrap_or_else(|e| panic!("{command}: {e:?}"))
+        };
+        call(planner::SET_ROBOT, serde_json::to_vec(&req.robot).unwrap());
+        call(
+            planner::SET_OBJECT,
+            serde_json::to_vec(&req.object).unwrap(),
+        );
+        call(planner::SET_ENV, serde_json::to_vec(&req.env).unwrap());
         let in_process: Vec<Duration> = (0..SEEDS)
             .map(|seed| {
-                let options = PlanOptions {
+                let body = serde_json::to_vec(&PlanOptions {
                     seed,
                     ..PlanOptions::default()
-                };
+                })
+                .unwrap();
                 let start = Instant::now();
-                local
-                    .plan(&options, &AtomicBool::new(false), &mut |_| {})
-                    .expect("plan");
+                call(planner::PLAN, body);
                 start.elapsed()
             })
             .collect();
