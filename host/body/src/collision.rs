@@ -439,22 +439,10 @@ pub enum DistanceMethod {
 }
 
 /// Closest points of two placed shapes (world poses `w1`, `w2`) by the fast
-/// paths, in parry's conventions (world frame); `None` when no fast path
-/// applies to the pair: `p2` is not a mesh, `p1` neither a ball nor a
-/// capsule, or `method` is parry's.
-fn fast_closest_points(
-    method: DistanceMethod,
-    w1: &Pose,
-    p1: &Part,
-    w2: &Pose,
-    p2: &Part,
-    max_distance: f64,
-) -> Option<ClosestPoints> {
-    fast_closest_triangle(method, w1, p1, w2, p2, max_distance).map(|(cp, _)| cp)
-}
-
-/// [`fast_closest_points`] with the index of the mesh triangle holding the
-/// witness point on the mesh, when separated.
+/// paths, in parry's conventions (world frame), with the index of the mesh
+/// triangle holding the witness point on the mesh when separated; `None`
+/// when no fast path applies to the pair: `p2` is not a mesh, `p1` neither a
+/// ball nor a capsule, or `method` is parry's.
 fn fast_closest_triangle(
     method: DistanceMethod,
     w1: &Pose,
@@ -497,7 +485,8 @@ fn closest_points(
     p2: &Part,
     max_distance: f64,
 ) -> Option<ClosestPoints> {
-    fast_closest_points(method, w1, p1, w2, p2, max_distance)
+    fast_closest_triangle(method, w1, p1, w2, p2, max_distance)
+        .map(|(cp, _)| cp)
         .or_else(|| query::closest_points(w1, &*p1.shape, w2, &*p2.shape, max_distance).ok())
 }
 
@@ -631,7 +620,8 @@ fn placed_collides(
         return false;
     }
     let (w1, w2) = (a.pose, b.pose);
-    let hit = if let Some(cp) = fast_closest_points(method, &w1, p1, &w2, p2, margin.max(0.0)) {
+    let fast = fast_closest_triangle(method, &w1, p1, &w2, p2, margin.max(0.0));
+    let hit = if let Some((cp, _)) = fast {
         // Margin 0 accepts only overlaps, like parry's intersection test.
         !matches!(cp, ClosestPoints::Disjoint)
     } else if margin > 0.0 {
