@@ -38,7 +38,7 @@
 //! [`IkSolution::beyond_reach`] set: a whole-body planner's arm-only stage
 //! costs nothing for an object on the floor.
 
-use nalgebra::{Cholesky, Isometry3, Matrix6, Point3, Vector6};
+use nalgebra::{Cholesky, Isometry3, Matrix6, Point3, Vector3, Vector6};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -256,42 +256,16 @@ impl<'m> IkSolver<'m> {
         let opts = self.options.clone();
         let n = self.selection.len();
         let mut rng = ChaCha8Rng::seed_from_u64(opts.seed);
-        let mut q = q_init.to_vec();
-        let rest: Vec<f64> = self
-            .selection
-            .joints
-            .iter()
-            .enumerate()
-            .map(|(c, &j)| rest.unwrap_or(q_init)[j].clamp(self.lower[c], self.upper[c]))
-            .collect();
-        for (c, &j) in self.selection.joints.iter().enumerate() {
-            q[j] = q[j].clamp(self.lower[c], self.upper[c]);
-        }
+        let (mut q, rest) = self.clamped_start(q_init, rest);
         let w_o = if orientation {
             opts.orientation_weight
         } else {
             0.0
         };
-        let target_p = Point3::from(target.translation.vector);
-        let start = self.chain_fk(&q, 0);
-        let beyond_reach = self
-            .reach
-            .beyond(self.model, &self.path, &self.poses, &q, &target_p);
-        if beyond_reach > opts.position_tolerance {
-            self.model.apply_mimics(&mut q);
-            return IkSolution {
-                ok: false,
-                q,
-                position_error: (target_p.coords - start.translation.vector).norm(),
-                orientation_error: match orientation {
-                    true => (target.rotation * start.rotation.inverse()).angle(),
-                    false => 0.0,
-                },
-                iterations: 0,
-                attempts: 0,
-                beyond_reach,
-            };
-        }
+        let beyond_reach = match self.out_of_reach(target, orientation, &mut q) {
+            Ok(beyond) => beyond,
+            Err(refused) => return refused,
+        };
         // Best configuration seen so far: (score, position error, orientation error).
         let mut best = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
         let mut best_q = q.clone();
@@ -307,14 +281,7 @@ impl<'m> IkSolver<'m> {
             let mut history = f64::INFINITY;
             for it in 0..opts.max_iterations {
                 iterations += 1;
-                let pose = self.chain_fk(&q, self.movers[0].0);
-                let p = Point3::from(pose.translation.vector);
-                let ep = target_p - p;
-                let eo = if orientation {
-                    (target.rotation * pose.rotation.inverse()).scaled_axis()
-                } else {
-                    nalgebra::Vector3::zeros()
-                };
+                let (p, ep, eo) = self.pose_error(&q, target, orientation);
                 let (pe, oe) = (ep.norm(), eo.norm());
                 if pe + w_o * oe < best.0 {
                     best = (pe + w_o * oe, pe, oe);
@@ -341,28 +308,7 @@ impl<'m> IkSolver<'m> {
                     }
                     history = energy;
                 }
-                // Jacobian columns (weighted like the error).
-                self.cols.iter_mut().for_each(|c| *c = Vector6::zeros());
-                for (k, pj) in &self.movers {
-                    let joint = &self.model.joints[pj.joint];
-                    let child = &self.poses[k + 1];
-                    let axis = child.rotation * joint.axis.into_inner();
-                    let col = match joint.kind {
-                        JointKind::Prismatic => Vector6::new(axis.x, axis.y, axis.z, 0.0, 0.0, 0.0),
-                        _ => {
-                            let lin = axis.cross(&(p - Point3::from(child.translation.vector)));
-                            Vector6::new(
-                                lin.x,
-                                lin.y,
-                                lin.z,
-                                w_o * axis.x,
-                                w_o * axis.y,
-                                w_o * axis.z,
-                            )
-                        }
-                    };
-                    self.cols[pj.column] += col * pj.multiplier;
-                }
+                self.jacobian(&p, w_o);
                 let lambda = energy + opts.min_damping;
                 // The damped pseudo-inverse leaks a little of the null-space
                 // pull into the task; near the goal that leak would stall
@@ -372,47 +318,7 @@ impl<'m> IkSolver<'m> {
                 } else {
                     0.0
                 };
-                locked.iter_mut().for_each(|l| *l = false);
-                for _pass in 0..4 {
-                    let mut a = Matrix6::identity() * lambda;
-                    for (c, col) in self.cols.iter().enumerate() {
-                        if !locked[c] {
-                            a.ger(1.0, col, col, 1.0);
-                        }
-                    }
-                    let Some(chol) = Cholesky::new(a) else { break };
-                    let y = chol.solve(&e);
-                    let mut jz = Vector6::zeros();
-                    for (c, &j) in self.selection.joints.iter().enumerate() {
-                        if locked[c] {
-                            dq[c] = 0.0;
-                            continue;
-                        }
-                        let z = gain * (rest[c] - q[j]);
-                        dq[c] = self.cols[c].dot(&y) + z;
-                        jz += self.cols[c] * z;
-                    }
-                    if gain != 0.0 {
-                        let w = chol.solve(&jz);
-                        for c in 0..n {
-                            if !locked[c] {
-                                dq[c] -= self.cols[c].dot(&w);
-                            }
-                        }
-                    }
-                    let mut relock = false;
-                    for (c, &j) in self.selection.joints.iter().enumerate() {
-                        let at_low = q[j] <= self.lower[c] + 1e-12 && dq[c] < 0.0;
-                        let at_high = q[j] >= self.upper[c] - 1e-12 && dq[c] > 0.0;
-                        if !locked[c] && (at_low || at_high) {
-                            locked[c] = true;
-                            relock = true;
-                        }
-                    }
-                    if !relock {
-                        break;
-                    }
-                }
+                self.damped_step(&e, (lambda, gain), (&rest, &q), (&mut dq, &mut locked));
                 // Cap the step so a far target does not throw the arm around.
                 let max_step = dq.iter().fold(0.0f64, |m, d| m.max(d.abs()));
                 let scale = if max_step > 0.5 { 0.5 / max_step } else { 1.0 };
@@ -430,6 +336,152 @@ impl<'m> IkSolver<'m> {
             iterations,
             attempts: opts.max_attempts.max(1),
             beyond_reach,
+        }
+    }
+
+    /// The start `q_init` and the rest pose (`rest`, else `q_init`; one
+    /// entry per selected joint) with the selected joints within limits.
+    fn clamped_start(&self, q_init: &[f64], rest: Option<&[f64]>) -> (Vec<f64>, Vec<f64>) {
+        let mut q = q_init.to_vec();
+        let rest: Vec<f64> = self
+            .selection
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(c, &j)| rest.unwrap_or(q_init)[j].clamp(self.lower[c], self.upper[c]))
+            .collect();
+        for (c, &j) in self.selection.joints.iter().enumerate() {
+            q[j] = q[j].clamp(self.lower[c], self.upper[c]);
+        }
+        (q, rest)
+    }
+
+    /// Before any attempt: how far the target lies beyond the chain's reach
+    /// (`Ok`, ≤ the tolerance), or the failed solution at `q` when farther.
+    fn out_of_reach(
+        &mut self,
+        target: &Isometry3<f64>,
+        orientation: bool,
+        q: &mut Vec<f64>,
+    ) -> Result<f64, IkSolution> {
+        let target_p = Point3::from(target.translation.vector);
+        let start = self.chain_fk(q, 0);
+        let beyond_reach = self
+            .reach
+            .beyond(self.model, &self.path, &self.poses, q, &target_p);
+        if beyond_reach <= self.options.position_tolerance {
+            return Ok(beyond_reach);
+        }
+        self.model.apply_mimics(q);
+        Err(IkSolution {
+            ok: false,
+            q: q.clone(),
+            position_error: (target_p.coords - start.translation.vector).norm(),
+            orientation_error: match orientation {
+                true => (target.rotation * start.rotation.inverse()).angle(),
+                false => 0.0,
+            },
+            iterations: 0,
+            attempts: 0,
+            beyond_reach,
+        })
+    }
+
+    /// The link's origin for `q` and its position and rotation-vector errors
+    /// to `target` (no rotation error without `orientation`).
+    fn pose_error(
+        &mut self,
+        q: &[f64],
+        target: &Isometry3<f64>,
+        orientation: bool,
+    ) -> (Point3<f64>, Vector3<f64>, Vector3<f64>) {
+        let pose = self.chain_fk(q, self.movers[0].0);
+        let p = Point3::from(pose.translation.vector);
+        let ep = Point3::from(target.translation.vector) - p;
+        let eo = match orientation {
+            true => (target.rotation * pose.rotation.inverse()).scaled_axis(),
+            false => Vector3::zeros(),
+        };
+        (p, ep, eo)
+    }
+
+    /// The Jacobian columns of the link's origin `p` at the poses of the last
+    /// chain FK, weighted like the error (rotation rows by `w_o`).
+    fn jacobian(&mut self, p: &Point3<f64>, w_o: f64) {
+        self.cols.iter_mut().for_each(|c| *c = Vector6::zeros());
+        for (k, pj) in &self.movers {
+            let joint = &self.model.joints[pj.joint];
+            let child = &self.poses[k + 1];
+            let axis = child.rotation * joint.axis.into_inner();
+            let col = match joint.kind {
+                JointKind::Prismatic => Vector6::new(axis.x, axis.y, axis.z, 0.0, 0.0, 0.0),
+                _ => {
+                    let lin = axis.cross(&(p - Point3::from(child.translation.vector)));
+                    Vector6::new(
+                        lin.x,
+                        lin.y,
+                        lin.z,
+                        w_o * axis.x,
+                        w_o * axis.y,
+                        w_o * axis.z,
+                    )
+                }
+            };
+            self.cols[pj.column] += col * pj.multiplier;
+        }
+    }
+
+    /// The damped least-squares step `dq` for error `e` with damping
+    /// `lambda` and null-space pull `gain` toward `rest`, a joint at a limit
+    /// that the step would push further locked and the step recomputed (up
+    /// to four passes).
+    fn damped_step(
+        &self,
+        e: &Vector6<f64>,
+        (lambda, gain): (f64, f64),
+        (rest, q): (&[f64], &[f64]),
+        (dq, locked): (&mut [f64], &mut [bool]),
+    ) {
+        locked.iter_mut().for_each(|l| *l = false);
+        for _pass in 0..4 {
+            let mut a = Matrix6::identity() * lambda;
+            for (c, col) in self.cols.iter().enumerate() {
+                if !locked[c] {
+                    a.ger(1.0, col, col, 1.0);
+                }
+            }
+            let Some(chol) = Cholesky::new(a) else { break };
+            let y = chol.solve(e);
+            let mut jz = Vector6::zeros();
+            for (c, &j) in self.selection.joints.iter().enumerate() {
+                if locked[c] {
+                    dq[c] = 0.0;
+                    continue;
+                }
+                let z = gain * (rest[c] - q[j]);
+                dq[c] = self.cols[c].dot(&y) + z;
+                jz += self.cols[c] * z;
+            }
+            if gain != 0.0 {
+                let w = chol.solve(&jz);
+                for (c, d) in dq.iter_mut().enumerate() {
+                    if !locked[c] {
+                        *d -= self.cols[c].dot(&w);
+                    }
+                }
+            }
+            let mut relock = false;
+            for (c, &j) in self.selection.joints.iter().enumerate() {
+                let at_low = q[j] <= self.lower[c] + 1e-12 && dq[c] < 0.0;
+                let at_high = q[j] >= self.upper[c] - 1e-12 && dq[c] > 0.0;
+                if !locked[c] && (at_low || at_high) {
+                    locked[c] = true;
+                    relock = true;
+                }
+            }
+            if !relock {
+                break;
+            }
         }
     }
 

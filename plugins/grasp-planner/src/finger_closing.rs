@@ -117,6 +117,8 @@ struct Closing<'a> {
     /// The first joint whose pose a step changes: the closing joint or a
     /// joint mimicking it (forward kinematics restarts there).
     first_joint: JointId,
+    /// Farthest a step moves a point of `links` ([`closing_speed`] · step).
+    per_step: f64,
     /// Query range during steps: a step moves no point of `links` by more
     /// than `speed · step` ([`closing_speed`]), so a link that was outside by
     /// at least the threshold is, after the step, either farther than this
@@ -127,7 +129,87 @@ struct Closing<'a> {
     reach: f64,
 }
 
-impl Closing<'_> {
+impl<'a> Closing<'a> {
+    /// The closing of contact `c` in steps of `step` (rad) down to `threshold`.
+    fn new(
+        hand: &'a HandModel,
+        c: &'a ResolvedContact,
+        object: &'a CollisionObject,
+        threshold: f64,
+        step: f64,
+    ) -> Self {
+        let robot = &hand.robot;
+        let speed = closing_speed(robot, &hand.collision, c.joint);
+        let moves = |j: usize| {
+            j == c.joint
+                || robot.joints[j]
+                    .mimic
+                    .as_ref()
+                    .is_some_and(|m| m.master == c.joint)
+        };
+        Closing {
+            hand,
+            c,
+            links: moved_links(hand, c.joint, c.link),
+            object,
+            first_joint: (0..robot.joints.len())
+                .find(|&j| moves(j))
+                .unwrap_or(c.joint),
+            per_step: speed * step,
+            reach: (speed * step + threshold).min(MAX_QUERY),
+        }
+    }
+
+    /// Turns the joint from its value in `q` until a link is within
+    /// `threshold` of the object (bisecting a step that went in): that link
+    /// and its proximity, with `q` and `fk` at that angle. `None` when the
+    /// finger starts inside the object, farther than [`MAX_QUERY`], or
+    /// reaches its limit (or a full turn) without touching.
+    fn touch(
+        &self,
+        q: &mut [f64],
+        fk: &mut FkState,
+        threshold: f64,
+        step: f64,
+    ) -> Option<(LinkId, Proximity)> {
+        let mut prev = q[self.c.joint];
+        let first = self.at(q, fk, prev, MAX_QUERY)?;
+        if first.1.distance < 0.0 {
+            return None; // starts inside the object
+        }
+        // Steps that cannot bring any link within the query range of the
+        // first distance (each moves a point by at most `per_step`): their
+        // queries would find nothing, so they are not made.
+        let mut skip = far_steps(first.1.distance, self.reach, self.per_step);
+        let mut near = Some(first);
+        let mut angle = prev;
+        // At most one turn, even for a joint without an upper limit.
+        let upper = self.hand.robot.joints[self.c.joint]
+            .limits
+            .upper
+            .min(prev + std::f64::consts::TAU);
+        let near = loop {
+            match near {
+                Some(n) if n.1.distance < threshold => break n,
+                _ if angle >= upper => return None, // closed fully without touching
+                _ => {}
+            }
+            prev = angle;
+            angle = (angle + step).min(upper);
+            if skip > 0 {
+                skip -= 1;
+                near = None;
+                continue;
+            }
+            near = self.at(q, fk, angle, self.reach);
+        };
+        // Overshot into the object: bisect the last step.
+        match near.1.distance < 0.0 {
+            true => self.bisect(q, fk, (prev, angle), threshold),
+            false => Some(near),
+        }
+    }
+
     /// The nearest of the links to the object with the joint at `angle`,
     /// within `limit` (`None`: all farther).
     fn at(
@@ -195,65 +277,10 @@ fn close_one(
     threshold: f64,
     step: f64,
 ) -> Option<FingerContact> {
-    let speed = closing_speed(&hand.robot, &hand.collision, c.joint);
-    let robot = &hand.robot;
-    let first_joint = (0..robot.joints.len())
-        .find(|&j| {
-            j == c.joint
-                || robot.joints[j]
-                    .mimic
-                    .as_ref()
-                    .is_some_and(|m| m.master == c.joint)
-        })
-        .unwrap_or(c.joint);
-    let closing = Closing {
-        hand,
-        c,
-        links: moved_links(hand, c.joint, c.link),
-        object,
-        first_joint,
-        reach: (speed * step + threshold).min(MAX_QUERY),
-    };
+    let closing = Closing::new(hand, c, object, threshold, step);
     // `fk` matches `q` from here on, but for the joints a step moves.
-    robot.forward_kinematics(q, fk);
-    let mut prev = q[c.joint];
-    let first = closing.at(q, fk, prev, MAX_QUERY)?;
-    if first.1.distance < 0.0 {
-        return None; // starts inside the object
-    }
-    // Steps that cannot bring any link within the query range of the
-    // first distance (each moves a point by at most `speed · step`): their
-    // queries would find nothing, so they are not made.
-    let mut skip = far_steps(first.1.distance, closing.reach, speed * step);
-    let mut near = Some(first);
-    let mut angle = prev;
-    // At most one turn, even for a joint without an upper limit.
-    let upper = hand.robot.joints[c.joint]
-        .limits
-        .upper
-        .min(prev + std::f64::consts::TAU);
-    let near = loop {
-        match near {
-            Some(n) if n.1.distance < threshold => break n,
-            _ if angle >= upper => return None, // closed fully without touching
-            _ => {}
-        }
-        prev = angle;
-        angle = (angle + step).min(upper);
-        if skip > 0 {
-            skip -= 1;
-            near = None;
-            continue;
-        }
-        near = closing.at(q, fk, angle, closing.reach);
-    };
-    // Overshot into the object: bisect the last step.
-    let near = if near.1.distance < 0.0 {
-        closing.bisect(q, fk, (prev, angle), threshold)?
-    } else {
-        near
-    };
-    let (link, prox) = near;
+    hand.robot.forward_kinematics(q, fk);
+    let (link, prox) = closing.touch(q, fk, threshold, step)?;
     let normal = -prox.normal.into_inner();
     // The kit's one rule: the effort limit through the finger's Jacobian,
     // capped by the description's `max_finger_force`, 0 N if not computable.

@@ -17,9 +17,11 @@
 //! against the environment and the object, closes the fingers
 //! ([`crate::finger_closing`]), checks again (contacting links may touch the
 //! object, nothing may touch the environment or the robot itself), computes
-//! the ellipsoid margin, checks the returned-grasp guarantees
-//! ([`crate::verify::check_grasp`]) and last runs the exact friction-cone
-//! program (`tsukami-grasp`), the costliest test: a grasp at margin ≥ δf must
+//! the ellipsoid margin, asks the certificates of earlier samples' weight
+//! programs whether this one can still hold the weight ([`WeightHints`]),
+//! checks the returned-grasp guarantees ([`crate::verify::check_grasp`]) and
+//! last runs the exact friction-cone program (`tsukami-grasp`), the costliest
+//! test: a grasp at margin ≥ δf must
 //! hold its weight there; one below δf (the ellipsoid is an inner
 //! approximation) is accepted when it is in exact force closure and holds
 //! [`SearchParams::exact_safety`] times its weight. The
@@ -37,6 +39,7 @@ use rand_chacha::ChaCha8Rng;
 use tsukami_body::collision::CollisionObject;
 use tsukami_body::ik::{IkOptions, IkSolver};
 use tsukami_body::kinematics::{FkState, JointSelection};
+use tsukami_body::model::JointId;
 use tsukami_grasp::contact::Contact;
 use tsukami_grasp::ellipsoid::{ellipsoid_test, EllipsoidModel};
 use tsukami_grasp::exact::{
@@ -203,38 +206,14 @@ pub fn search(
     progress: &mut dyn FnMut(&Counters),
 ) -> Outcome {
     let hand = ctx.hand;
-    let robot = &hand.robot;
     let p = ctx.params;
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let ik_opts = IkOptions {
-        max_attempts: 2,
-        max_iterations: 40,
-        position_tolerance: 1e-4,
-        orientation_tolerance: 1e-3,
-        seed,
-        ..IkOptions::default()
-    };
-    let Ok(sel) = JointSelection::new(robot, &stage.joints) else {
+    let Some(mut sampler) = Sampler::new(ctx, (t, stage), (nominal_palm, q_nominal), seed) else {
         return Outcome::Exhausted;
     };
-    let Ok(mut ik) = IkSolver::new(robot, hand.palm, sel, ik_opts.clone()) else {
-        return Outcome::Exhausted;
-    };
-    // In the squat stage, Δp_s fixes the squat joint and IK uses the rest.
-    let squat = (stage.stage == Stage::Squat)
-        .then_some(hand.squat)
-        .flatten();
-    let mut ik_no_squat = squat.and_then(|s| {
-        let joints: Vec<_> = stage.joints.iter().copied().filter(|&j| j != s).collect();
-        let sel = JointSelection::new(robot, &joints).ok()?;
-        IkSolver::new(robot, hand.palm, sel, ik_opts.clone()).ok()
-    });
     let g = &hand.config.grasp_types[t];
-    let approach = g.approach();
-    let spec = &hand.types[t];
     let links = LinkSets::for_type(hand, t, &stage.extra);
     let object = &ctx.object.collision;
-    let mut fk = FkState::new(robot);
+    let mut fk = FkState::new(&hand.robot);
     let mut q = q_nominal.to_vec();
     let mut exact_ms = 0.0;
     for s in 0..p.max_samples {
@@ -248,51 +227,11 @@ pub fn search(
         if counters.samples.is_multiple_of(16) {
             progress(counters);
         }
-        // Δp_p: the OCP's offset w.r.t. the GRC moves the palm by −Δp_p.
-        let palm = if s == 0 {
-            *nominal_palm
-        } else {
-            let mut d = Vector3::new(
-                rng.random_range(-p.palm_offset..=p.palm_offset),
-                rng.random_range(-p.palm_offset..=p.palm_offset),
-                rng.random_range(-p.palm_offset..=p.palm_offset),
-            );
-            let along = d.dot(&approach);
-            d += approach * (along.clamp(-p.approach_offset, p.approach_offset) - along);
-            Isometry3::from_parts(
-                Translation3::from(nominal_palm.translation.vector - nominal_palm.rotation * d),
-                nominal_palm.rotation,
-            )
-        };
-        // Δp_s: the shoulder height, only where squatting is allowed.
-        q.copy_from_slice(q_nominal);
-        let sol = match (squat, ik_no_squat.as_mut()) {
-            (Some(sj), Some(solver)) if s > 0 => {
-                let l = &robot.joints[sj].limits;
-                q[sj] = (q_nominal[sj] + rng.random_range(p.squat_offset.0..=p.squat_offset.1))
-                    .clamp(l.lower, l.upper);
-                solver.solve(&palm, true, &q, Some(q_nominal))
-            }
-            _ => ik.solve(&palm, true, &q, Some(q_nominal)),
-        };
-        if !sol.ok {
+        let Some(palm) = sampler.draw(s, &mut q) else {
             counters.reject(0, None);
             continue;
-        }
-        // The nominal's hand posture (the reference posture, or its
-        // pre-flexed form, `crate::clearance`) + Δa_i.
-        q.copy_from_slice(&sol.q);
-        if s > 0 {
-            for c in &spec.contacts {
-                for &j in &c.perturb {
-                    let l = &robot.joints[j].limits;
-                    q[j] = (q[j] + rng.random_range(-p.finger_offset..=p.finger_offset))
-                        .clamp(l.lower, l.upper);
-                }
-            }
-            robot.apply_mimics(&mut q);
-        }
-        robot.forward_kinematics(&q, &mut fk);
+        };
+        hand.robot.forward_kinematics(&q, &mut fk);
         if let Some(why) = links.blocked(hand, &fk, object, ctx.env, false) {
             counters.reject(1, Some(why));
             continue;
@@ -313,49 +252,192 @@ pub fn search(
             counters.reject(3, Some(why));
             continue;
         }
-        let Some((margin, grasp)) = ellipsoid_margin(ctx.object, &contacts) else {
-            counters.reject(4, None);
+        let closed = Closed {
+            fk: &fk,
+            links: &links,
+            contacts: &contacts,
+        };
+        let Some(margin) = accept(ctx, &closed, counters, &mut exact_ms) else {
             continue;
         };
-        if counters.best_margin.is_none_or(|b| margin > b) {
-            counters.best_margin = Some(margin);
-        }
-        // Eq. (10)'s margin reached: the exact friction cones must confirm
-        // it. Not reached: the ellipsoid is an inner approximation, so the
-        // exact test decides, with the safety factor `exact_safety` on the
-        // weight. A certificate of an earlier sample may already rule the
-        // sample out (cheap); then the guarantees of a returned grasp, on the
-        // final posture; then the exact programs, the costliest test.
-        let safety = match margin >= p.delta_f {
-            true => 1.0,
-            false => p.exact_safety,
-        };
-        if counters.hints.rule_out(ctx.object, &grasp, safety) {
-            counters.reject(4, None);
-            continue;
-        }
-        if let Err(r) = check_grasp(hand, &fk, &links.moving, object, ctx.env, &contacts) {
-            counters.reject(5, Some(r.label(&hand.robot)));
-            continue;
-        }
-        let t_exact = Instant::now();
-        let exact = exact_resists(ctx.object, &grasp, safety, &mut counters.hints);
-        exact_ms += t_exact.elapsed().as_secs_f64() * 1e3;
-        if !exact {
-            counters.reject(4, None);
-            continue;
-        }
         progress(counters);
         return Outcome::Found(Box::new(Found {
             q,
             palm,
             contacts,
             margin,
-            exact_resists_weight: exact,
+            exact_resists_weight: true,
             exact_ms,
         }));
     }
     Outcome::Exhausted
+}
+
+/// A sample's closed hand: the posture, the stage's link sets, the contacts.
+struct Closed<'a> {
+    fk: &'a FkState,
+    links: &'a LinkSets,
+    contacts: &'a [FingerContact],
+}
+
+/// The force tests of a closed hand: its ellipsoid margin (eq. (10)) when
+/// it is accepted, `None` (the rejection counted) otherwise. Eq. (10)'s
+/// margin reached: the exact friction cones must confirm it. Not reached:
+/// the ellipsoid is an inner approximation, so the exact test decides, with
+/// the safety factor `exact_safety` on the weight. A certificate of an
+/// earlier sample may already rule the sample out (cheap); then the
+/// guarantees of a returned grasp, on the final posture; then the exact
+/// programs, the costliest test (their time is added to `exact_ms`).
+fn accept(
+    ctx: &SearchContext<'_>,
+    closed: &Closed<'_>,
+    counters: &mut Counters,
+    exact_ms: &mut f64,
+) -> Option<f64> {
+    let p = ctx.params;
+    let Some((margin, grasp)) = ellipsoid_margin(ctx.object, closed.contacts) else {
+        counters.reject(4, None);
+        return None;
+    };
+    if counters.best_margin.is_none_or(|b| margin > b) {
+        counters.best_margin = Some(margin);
+    }
+    let safety = match margin >= p.delta_f {
+        true => 1.0,
+        false => p.exact_safety,
+    };
+    if counters.hints.rule_out(ctx.object, &grasp, safety) {
+        counters.reject(4, None);
+        return None;
+    }
+    let (hand, object) = (ctx.hand, &ctx.object.collision);
+    if let Err(r) = check_grasp(
+        hand,
+        closed.fk,
+        &closed.links.moving,
+        object,
+        ctx.env,
+        closed.contacts,
+    ) {
+        counters.reject(5, Some(r.label(&hand.robot)));
+        return None;
+    }
+    let t_exact = Instant::now();
+    let exact = exact_resists(ctx.object, &grasp, safety, &mut counters.hints);
+    *exact_ms += t_exact.elapsed().as_secs_f64() * 1e3;
+    if !exact {
+        counters.reject(4, None);
+        return None;
+    }
+    Some(margin)
+}
+
+/// The samples of Algorithm 1 around one nominal pose: Δp_p (the palm),
+/// Δp_s (the shoulder height, in the squat stage) and Δa_i (the fingers'
+/// pre-shape), drawn in that order from one ChaCha8 generator.
+struct Sampler<'a> {
+    ctx: &'a SearchContext<'a>,
+    t: usize,
+    rng: ChaCha8Rng,
+    ik: IkSolver<'a>,
+    /// The squat joint and the IK over the stage's other joints.
+    squat: Option<(JointId, IkSolver<'a>)>,
+    nominal_palm: &'a Isometry3<f64>,
+    q_nominal: &'a [f64],
+}
+
+impl<'a> Sampler<'a> {
+    fn new(
+        ctx: &'a SearchContext<'a>,
+        (t, stage): (usize, &StageJoints),
+        (nominal_palm, q_nominal): (&'a Isometry3<f64>, &'a [f64]),
+        seed: u64,
+    ) -> Option<Self> {
+        let robot = &ctx.hand.robot;
+        let palm = ctx.hand.palm;
+        let ik_opts = IkOptions {
+            max_attempts: 2,
+            max_iterations: 40,
+            position_tolerance: 1e-4,
+            orientation_tolerance: 1e-3,
+            seed,
+            ..IkOptions::default()
+        };
+        let sel = JointSelection::new(robot, &stage.joints).ok()?;
+        let ik = IkSolver::new(robot, palm, sel, ik_opts.clone()).ok()?;
+        // In the squat stage, Δp_s fixes the squat joint and IK uses the rest.
+        let squat = (stage.stage == Stage::Squat)
+            .then_some(ctx.hand.squat)
+            .flatten()
+            .and_then(|s| {
+                let joints: Vec<_> = stage.joints.iter().copied().filter(|&j| j != s).collect();
+                let sel = JointSelection::new(robot, &joints).ok()?;
+                Some((s, IkSolver::new(robot, palm, sel, ik_opts).ok()?))
+            });
+        Some(Self {
+            ctx,
+            t,
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            ik,
+            squat,
+            nominal_palm,
+            q_nominal,
+        })
+    }
+
+    /// Sample `s` (the first is the nominal pose itself): its palm pose,
+    /// with its posture in `q`; `None` when the IK has no solution.
+    fn draw(&mut self, s: u32, q: &mut [f64]) -> Option<Isometry3<f64>> {
+        let (p, robot) = (self.ctx.params, &self.ctx.hand.robot);
+        let nominal = self.nominal_palm;
+        // Δp_p: the OCP's offset w.r.t. the GRC moves the palm by −Δp_p.
+        let palm = if s == 0 {
+            *nominal
+        } else {
+            let rng = &mut self.rng;
+            let mut d = Vector3::new(
+                rng.random_range(-p.palm_offset..=p.palm_offset),
+                rng.random_range(-p.palm_offset..=p.palm_offset),
+                rng.random_range(-p.palm_offset..=p.palm_offset),
+            );
+            let approach = self.ctx.hand.config.grasp_types[self.t].approach();
+            let along = d.dot(&approach);
+            d += approach * (along.clamp(-p.approach_offset, p.approach_offset) - along);
+            Isometry3::from_parts(
+                Translation3::from(nominal.translation.vector - nominal.rotation * d),
+                nominal.rotation,
+            )
+        };
+        // Δp_s: the shoulder height, only where squatting is allowed.
+        q.copy_from_slice(self.q_nominal);
+        let sol = match self.squat.as_mut() {
+            Some((sj, solver)) if s > 0 => {
+                let l = &robot.joints[*sj].limits;
+                q[*sj] = (self.q_nominal[*sj]
+                    + self.rng.random_range(p.squat_offset.0..=p.squat_offset.1))
+                .clamp(l.lower, l.upper);
+                solver.solve(&palm, true, q, Some(self.q_nominal))
+            }
+            _ => self.ik.solve(&palm, true, q, Some(self.q_nominal)),
+        };
+        if !sol.ok {
+            return None;
+        }
+        // The nominal's hand posture (the reference posture, or its
+        // pre-flexed form, `crate::clearance`) + Δa_i.
+        q.copy_from_slice(&sol.q);
+        if s > 0 {
+            for c in &self.ctx.hand.types[self.t].contacts {
+                for &j in &c.perturb {
+                    let l = &robot.joints[j].limits;
+                    q[j] = (q[j] + self.rng.random_range(-p.finger_offset..=p.finger_offset))
+                        .clamp(l.lower, l.upper);
+                }
+            }
+            robot.apply_mimics(q);
+        }
+        Some(palm)
+    }
 }
 
 /// The grasp of `contacts` on `object` (torques about the centre of mass).
