@@ -148,6 +148,25 @@ fn model_ik_reaches_a_pose_the_arm_can_reach() {
     assert_eq!(ik["ok"], true, "{ik}");
     assert!(ik["position_error"].as_f64().unwrap() < 1e-3);
     assert_eq!(ik["joint_positions"].as_object().unwrap().len(), 7);
+    // 3 m in front of the robot: refused without an attempt, and said why.
+    let far = json(&tsukami(
+        &[
+            "model",
+            "ik",
+            &humanoid(),
+            "--link",
+            "r_palm",
+            "--target",
+            "3,0,1,0,0,0,1",
+            "--joints",
+            arm,
+        ],
+        None,
+    ));
+    assert_eq!(far["ok"], false, "{far}");
+    assert_eq!(far["attempts"], 0, "{far}");
+    let message = far["message"].as_str().unwrap();
+    assert!(message.contains("beyond the reach"), "{message}");
 }
 
 #[test]
