@@ -114,18 +114,16 @@ impl ChainReach {
             return (t - o).norm() - self.suffix[0];
         }
         let axis = frame.rotation * joint.axis.into_inner();
-        // The next pivot (or the link) circles the axis through `o`: a torus.
-        let next = self.origin(model, path, frames, 1);
-        let along = axis.dot(&(next - o));
-        let torus = meridian_distance(
-            (
-                axis.dot(&(t - o)),
-                ((t - o) - axis * axis.dot(&(t - o))).norm(),
-            ),
-            (along, 0.0),
-            ((next - o) - axis * along).norm(),
-            (0.0, std::f64::consts::PI),
-        ) - self.suffix[1];
+        // The next pivot (or the link) circles the axis through `o`: in the
+        // axis' meridian half-plane (height along it, distance from it) the
+        // circle is one point, and the target must be within the rest of the
+        // chain's reach of it (a torus).
+        let next = self.origin(model, path, frames, 1) - o;
+        let along = axis.dot(&next);
+        let radius = (next - axis * along).norm();
+        let height = axis.dot(&(t - o));
+        let across = ((t - o) - axis * height).norm();
+        let torus = (height - along).hypot(across - radius) - self.suffix[1];
         torus.max(self.second_pivot_bound(model, path, frames, q, (o, axis), t))
     }
 
