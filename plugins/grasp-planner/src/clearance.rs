@@ -19,9 +19,9 @@
 //! itself (the upper arm in the chest) or against the object triggers the IK
 //! again from other arm postures ([`ARM_STARTS`]), which a lift would not
 //! change; a hand link on the object triggers neither (the palm pose places
-//! the hand, whatever the arm does). A lift whose IK fails is skipped. The unlifted pose and the usual
-//! IK start are tried first, so a scene whose nominal is already clear is
-//! unchanged.
+//! the hand, whatever the arm does). A lift whose IK fails is skipped. The
+//! unlifted pose and the usual IK start are tried first, so a scene whose
+//! nominal is already clear is unchanged.
 //!
 //! ```
 //! use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
