@@ -362,7 +362,7 @@ impl<'m> IkSolver<'m> {
         &mut self,
         target: &Isometry3<f64>,
         orientation: bool,
-        q: &mut Vec<f64>,
+        q: &mut [f64],
     ) -> Result<f64, IkSolution> {
         let target_p = Point3::from(target.translation.vector);
         let start = self.chain_fk(q, 0);
@@ -375,7 +375,7 @@ impl<'m> IkSolver<'m> {
         self.model.apply_mimics(q);
         Err(IkSolution {
             ok: false,
-            q: q.clone(),
+            q: q.to_vec(),
             position_error: (target_p.coords - start.translation.vector).norm(),
             orientation_error: match orientation {
                 true => (target.rotation * start.rotation.inverse()).angle(),

@@ -209,7 +209,8 @@ fn meridian_distance(p: (f64, f64), centre: (f64, f64), r: f64, (from, to): (f64
 /// The range of `A + B cos δ + C sin δ` over `δ ∈ [d0, d1]`.
 fn sinusoid_range((a, b, c): (f64, f64, f64), (d0, d1): (f64, f64)) -> (f64, f64) {
     let amplitude = b.hypot(c);
-    if !(d1 - d0 < std::f64::consts::TAU) {
+    // A full turn (or an interval that is not a number): the whole swing.
+    if (d1 - d0).partial_cmp(&std::f64::consts::TAU) != Some(std::cmp::Ordering::Less) {
         return (a - amplitude, a + amplitude);
     }
     let f = |d: f64| a + b * d.cos() + c * d.sin();

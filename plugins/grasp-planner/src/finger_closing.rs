@@ -301,3 +301,25 @@ fn close_one(
         distance: prox.distance,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::far_steps;
+
+    #[test]
+    fn far_steps_are_exactly_those_that_stay_out_of_range() {
+        // The first finger of the fridge scene: 30.3 mm away, a query range
+        // of 7.8 mm, 5.8 mm a step at most: steps 1–3 cannot come in range.
+        assert_eq!(far_steps(0.0303, 0.0078, 0.0058), 3);
+        for (d, r, m) in [(0.05, 0.004, 0.001), (0.01, 0.002, 0.003), (0.2, 0.2, 0.01)] {
+            let k = far_steps(d, r, m) as f64;
+            assert!(d - k * m > r || k == 0.0, "{d} {r} {m}: {k}");
+            // The next step might come in range: it is queried.
+            assert!(d - (k + 1.0) * m <= r + 1e-12, "{d} {r} {m}: {k}");
+        }
+        assert_eq!(far_steps(0.001, 0.002, 0.001), 0);
+        assert_eq!(far_steps(0.05, 0.002, 0.0), 0);
+        assert_eq!(far_steps(f64::NAN, 0.002, 0.001), 0);
+        assert_eq!(far_steps(f64::INFINITY, 0.002, 0.001), 0);
+    }
+}
