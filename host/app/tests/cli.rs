@@ -129,40 +129,21 @@ fn model_ik_reaches_a_pose_the_arm_can_reach() {
         "{},{},{},{},{},{},{}",
         p[0], p[1], p[2], q[0], q[1], q[2], q[3]
     );
-    let ik = json(&tsukami(
-        &[
-            "model",
-            "ik",
-            &humanoid(),
-            "--link",
-            "r_palm",
-            "--target",
-            &target,
-            "--joints",
-            arm,
-            "--seed",
-            "3",
-        ],
-        None,
-    ));
+    // The arm's IK of the palm to `target` (`x,y,z,qx,qy,qz,qw`), seed 3.
+    let palm_ik = |target: &str| {
+        let urdf = humanoid();
+        let args = [
+            "model", "ik", &urdf, "--link", "r_palm", "--target", target, "--joints", arm,
+            "--seed", "3",
+        ];
+        json(&tsukami(&args, None))
+    };
+    let ik = palm_ik(&target);
     assert_eq!(ik["ok"], true, "{ik}");
     assert!(ik["position_error"].as_f64().unwrap() < 1e-3);
     assert_eq!(ik["joint_positions"].as_object().unwrap().len(), 7);
     // 3 m in front of the robot: refused without an attempt, and said why.
-    let far = json(&tsukami(
-        &[
-            "model",
-            "ik",
-            &humanoid(),
-            "--link",
-            "r_palm",
-            "--target",
-            "3,0,1,0,0,0,1",
-            "--joints",
-            arm,
-        ],
-        None,
-    ));
+    let far = palm_ik("3,0,1,0,0,0,1");
     assert_eq!(far["ok"], false, "{far}");
     assert_eq!(far["attempts"], 0, "{far}");
     let message = far["message"].as_str().unwrap();
