@@ -211,25 +211,23 @@ fn model_compose_declares_a_palm_frame_above_the_hand() {
     let arm = third.join("pybullet_data/kuka_iiwa/model.urdf");
     let hand = third
         .join("example-robot-data/robots/allegro_hand_description/urdf/allegro_right_hand.urdf");
-    let out = tsukami(
-        &[
-            "model",
-            "compose",
-            &arm.display().to_string(),
-            &hand.display().to_string(),
-            "--at",
-            "lbr_iiwa_link_7",
-            "--xyz",
-            "0,0,0.14",
-            "--palm-frame",
-            "palm",
-            "--palm-xyz",
-            "0.0111,0,-0.0475",
-            "--palm-rpy",
-            "0,-1.5707963267948966,3.141592653589793",
-        ],
-        None,
-    );
+    // `tsukami model compose ARM HAND --at lbr_iiwa_link_7 EXTRA…`.
+    let compose = |extra: &[&str]| {
+        let (arm, hand) = (arm.display().to_string(), hand.display().to_string());
+        let mut args = vec!["model", "compose", &arm, &hand, "--at", "lbr_iiwa_link_7"];
+        args.extend_from_slice(extra);
+        tsukami(&args, None)
+    };
+    let out = compose(&[
+        "--xyz",
+        "0,0,0.14",
+        "--palm-frame",
+        "palm",
+        "--palm-xyz",
+        "0.0111,0,-0.0475",
+        "--palm-rpy",
+        "0,-1.5707963267948966,3.141592653589793",
+    ]);
     assert!(
         out.status.success(),
         "{}",
@@ -246,19 +244,7 @@ fn model_compose_declares_a_palm_frame_above_the_hand() {
     let joints = |t: &str| t.matches("<joint ").count();
     assert_eq!(joints(&urdf), joints(&committed));
     // A frame name the hand already uses is refused, naming it.
-    let clash = tsukami(
-        &[
-            "model",
-            "compose",
-            &arm.display().to_string(),
-            &hand.display().to_string(),
-            "--at",
-            "lbr_iiwa_link_7",
-            "--palm-frame",
-            "link_0.0",
-        ],
-        None,
-    );
+    let clash = compose(&["--palm-frame", "link_0.0"]);
     assert!(!clash.status.success());
     assert!(String::from_utf8_lossy(&clash.stderr).contains("link_0.0"));
 }
