@@ -556,6 +556,16 @@ pub struct PhaseTiming {
     pub total: f64,
 }
 
+/// An approach turned from a face's inward normal toward a neighbour face:
+/// the hand comes from between the two faces.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct FaceTilt {
+    /// The neighbour face the approach turned toward.
+    pub toward: BoxFace,
+    /// The angle between the approach and the face's inward normal, radians.
+    pub angle: f64,
+}
+
 /// Reply to [`PlanOptions`]: one planned grasp (the field contract of issue #5).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct PlanReply {
@@ -565,6 +575,10 @@ pub struct PlanReply {
     pub ocp_region: usize,
     /// Face of that OCP the hand approached.
     pub face: BoxFace,
+    /// How the approach was turned from the face's inward normal toward a
+    /// neighbour face; absent when the hand came straight along the normal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tilt: Option<FaceTilt>,
     /// Palm (`r_palm` frame) pose in the world frame.
     pub palm_pose: Pose,
     /// Every joint used (waist, squat, arm, hand): name → position (rad or m).
@@ -650,6 +664,10 @@ mod tests {
             },
             ocp_region: 0,
             face: BoxFace::NegX,
+            tilt: Some(FaceTilt {
+                toward: BoxFace::PosZ,
+                angle: 0.5,
+            }),
             palm_pose: Pose::IDENTITY,
             joint_positions: BTreeMap::from([("r_elbow".to_string(), -1.0)]),
             joints_used: vec!["squat_z".into()],

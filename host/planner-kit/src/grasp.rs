@@ -15,7 +15,8 @@ use nalgebra::{Point3, Vector3};
 use tsukami_body::kinematics::FkState;
 use tsukami_body::model::{JointId, LinkId};
 use tsukami_msgs::planner::{
-    BoxFace, ContactReply, ForceClosureReply, GraspTypeRef, ObjectMass, PhaseTiming, PlanReply,
+    BoxFace, ContactReply, FaceTilt, ForceClosureReply, GraspTypeRef, ObjectMass, PhaseTiming,
+    PlanReply,
 };
 
 use crate::planner::{GraspPlanner, World};
@@ -44,6 +45,8 @@ pub struct Grasp {
     pub region: usize,
     /// Face of that region the hand approached.
     pub face: BoxFace,
+    /// The approach's turn from the face's normal, if any.
+    pub tilt: Option<FaceTilt>,
     /// The whole configuration (every joint of the model).
     pub q: Vec<f64>,
     /// Joints the stage moved (arm and extra joints); hand joints are added.
@@ -72,6 +75,7 @@ impl Grasp {
             grasp_type,
             region: 0,
             face,
+            tilt: None,
             q,
             joints: stage.joints.clone(),
             extra: stage.extra.clone(),
@@ -117,6 +121,7 @@ pub fn reply<P: GraspPlanner>(
         grasp_type: grasp.grasp_type.clone(),
         ocp_region: grasp.region,
         face: grasp.face,
+        tilt: grasp.tilt,
         palm_pose: to_pose(fk.pose(hand.palm)),
         joint_positions,
         joints_used: robot.names(&grasp.extra),

@@ -143,7 +143,15 @@ fn run_case(
 }
 
 fn describe(r: &PlanReply) -> String {
-    format!("{} face {}", r.grasp_type.name, r.face.as_str())
+    let tilt = match r.tilt {
+        Some(t) => format!(
+            " tilted {:.0}° toward {}",
+            t.angle.to_degrees(),
+            t.toward.as_str()
+        ),
+        None => String::new(),
+    };
+    format!("{} face {}{tilt}", r.grasp_type.name, r.face.as_str())
 }
 
 fn report(outcomes: &[Outcome]) {

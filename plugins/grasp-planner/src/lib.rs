@@ -5,7 +5,8 @@
 //!
 //! Pipeline, one module per step:
 //! [`ocp`] (object boxes and free faces) → [`selection`] (eqs. (1)–(5), score
-//! (3)) → [`palm_pose`] (nominal palm pose, section 3.2) → [`search`]
+//! (3)) → [`palm_pose`] (nominal palm pose, section 3.2; [`tilt`] for the
+//! approaches at an angle tried when the paper's fail) → [`search`]
 //! (Algorithm 1, with [`finger_closing`]) → [`whole_body`] (section 3.4
 //! fallback), driven by [`planner::Paper`], the planner kit's `GraspPlanner`.
 //! The hand's reference postures are the kit's grasp types ([`grasp_type`],
@@ -46,5 +47,6 @@ pub mod search;
 pub mod selection;
 pub mod support;
 pub mod tight_box;
+pub mod tilt;
 pub mod verify;
 pub mod whole_body;

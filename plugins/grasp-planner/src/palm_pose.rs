@@ -30,6 +30,7 @@ use crate::grasp_type::GraspType;
 use crate::hand::HandModel;
 use crate::ocp::Ocp;
 use crate::selection::grc_edges_in_palm;
+use crate::tilt::Tilt;
 
 /// How far above the support GRCdes's lowest corner is kept on a side face (m).
 pub const FLOOR_CLEARANCE: f64 = 0.01;
@@ -45,11 +46,14 @@ pub struct PalmTarget {
 
 /// Palm poses of the four GRC rotations on `face` of `ocp` that pass the
 /// containment check of section 3.2; `floor` is the height of the support the
-/// object stands on, if any (see the module documentation).
+/// object stands on, if any (see the module documentation). With a `tilt`,
+/// each pose is turned by it about the point the hand holds, and the object
+/// is measured across the turned palm by projection ([`crate::tilt`]).
 pub fn palm_targets(
     g: &GraspType,
     ocp: &Ocp,
     face: BoxFace,
+    tilt: Option<Tilt>,
     floor: Option<f64>,
 ) -> Vec<PalmTarget> {
     let a = g.approach();
@@ -60,12 +64,19 @@ pub fn palm_targets(
     let (min_p, _) = grc_edges_in_palm(&g.grc_min, &a);
     let (des_p, _) = grc_edges_in_palm(&g.grc_des, &a);
     let k = face.axis();
-    let n = ocp.face_normal(face);
+    let turn = tilt.map(|t| crate::tilt::rotation(&t, ocp, face));
+    // The outward approach (palm side) and the object's depth along it.
+    let (n, depth) = match turn {
+        None => (ocp.face_normal(face), ocp.extents[k]),
+        Some(r) => {
+            let n = r * ocp.face_normal(face);
+            (n, across(ocp, &n))
+        }
+    };
     let m = ocp.rotation.matrix();
     let (iu, iv) = ((k + 1) % 3, (k + 2) % 3);
     let (u, v) = (m.column(iu).into_owned(), m.column(iv).into_owned());
     let (eu, ev) = (ocp.extents[iu], ocp.extents[iv]);
-    let depth = ocp.extents[k];
     let shift = ((depth - des_p[ka]) * 0.5).max(0.0);
     let target = ocp.center + n * shift;
     let orders = [
@@ -76,33 +87,35 @@ pub fn palm_targets(
     ];
     let mut out = Vec::new();
     for (r, (d1, _d2, e1, e2)) in orders.into_iter().enumerate() {
+        // Columns: palm axis ka -> sa·(−n); p1 -> d1; p2 = ka × p1.
+        let mut cols = [Vector3::zeros(); 3];
+        cols[ka] = -ocp.face_normal(face) * sa;
+        cols[p1] = d1;
+        cols[p2] = cols[ka].cross(&cols[p1]);
+        let rot = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&cols));
+        let mut rot = UnitQuaternion::from_rotation_matrix(&rot);
+        let (e1, e2) = match turn {
+            None => (e1, e2),
+            Some(t) => {
+                rot = t * rot;
+                (
+                    across(ocp, &(rot * cols_axis(p1))),
+                    across(ocp, &(rot * cols_axis(p2))),
+                )
+            }
+        };
         // Containment: GRCmax holds the face, GRCmin fits on it.
         let fits = e1 < max_p[p1] && e2 < max_p[p2] && e1 > min_p[p1] && e2 > min_p[p2];
         if !fits {
             continue;
         }
-        // Columns: palm axis ka -> sa·(−n); p1 -> d1; p2 = ka × p1.
-        let mut cols = [Vector3::zeros(); 3];
-        cols[ka] = -n * sa;
-        cols[p1] = d1;
-        cols[p2] = cols[ka].cross(&cols[p1]);
-        let rot = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&cols));
-        let rot = UnitQuaternion::from_rotation_matrix(&rot);
         let grc_centre = Vector3::from(g.grc_des.position);
         let mut palm_pos = target.coords - rot * grc_centre;
         if let Some(floor) = floor {
             // Half the face's extent along the world vertical: how far the
             // GRC centre may rise and stay on the face.
             let reach = 0.5 * (u.z.abs() * eu + v.z.abs() * ev);
-            let half = Vector3::from(g.grc_des.size) * 0.5;
-            let lowest = (0..8)
-                .map(|c| {
-                    let sign = |b: usize| if c >> b & 1 == 1 { 1.0 } else { -1.0 };
-                    let corner = grc_centre
-                        + Vector3::new(sign(0) * half.x, sign(1) * half.y, sign(2) * half.z);
-                    (palm_pos + rot * corner).z
-                })
-                .fold(f64::INFINITY, f64::min);
+            let lowest = lowest_corner(g, &rot, &palm_pos);
             palm_pos.z += (floor + FLOOR_CLEARANCE - lowest).clamp(0.0, reach);
         }
         out.push(PalmTarget {
@@ -111,6 +124,33 @@ pub fn palm_targets(
         });
     }
     out
+}
+
+/// The palm frame's axis `k` (in the palm frame).
+fn cols_axis(k: usize) -> Vector3<f64> {
+    Vector3::ith(k, 1.0)
+}
+
+/// The OCP's full extent along the world unit direction `w`.
+fn across(ocp: &Ocp, w: &Vector3<f64>) -> f64 {
+    let m = ocp.rotation.matrix();
+    (0..3)
+        .map(|k| m.column(k).dot(w).abs() * ocp.extents[k])
+        .sum()
+}
+
+/// The world height of GRCdes's lowest corner with the palm at `rot`, `pos`.
+fn lowest_corner(g: &GraspType, rot: &UnitQuaternion<f64>, pos: &Vector3<f64>) -> f64 {
+    let centre = Vector3::from(g.grc_des.position);
+    let half = Vector3::from(g.grc_des.size) * 0.5;
+    (0..8)
+        .map(|c| {
+            let sign = |b: usize| if c >> b & 1 == 1 { 1.0 } else { -1.0 };
+            let corner =
+                centre + Vector3::new(sign(0) * half.x, sign(1) * half.y, sign(2) * half.z);
+            (pos + rot * corner).z
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The palm-pose criterion for joint positions `q` (smaller is better).
@@ -165,7 +205,7 @@ mod tests {
             blocked: [None; 6],
         };
         // Face +y of the box = world −x: facing the robot.
-        let t = palm_targets(g, &ocp, BoxFace::PosY, None);
+        let t = palm_targets(g, &ocp, BoxFace::PosY, None, None);
         // GRCmin's palm-y edge (0.09) only fits along the can's height: 2 of 4 rotations.
         assert_eq!(t.len(), 2);
         for p in &t {
@@ -178,6 +218,48 @@ mod tests {
             assert!((c - ocp.center).norm() < 1e-9);
         }
         // The top is too narrow for this GRCmin.
-        assert!(palm_targets(g, &ocp, BoxFace::PosX, None).is_empty());
+        assert!(palm_targets(g, &ocp, BoxFace::PosX, None, None).is_empty());
+    }
+
+    #[test]
+    fn a_tilted_approach_comes_between_two_faces_and_measures_by_projection() {
+        // GRCmin 30 mm across both palm axes: wider than the box is tall.
+        let cfg = GraspTypeConfig::from_toml_str(&crate::grasp_type::ONE_TYPE_EXAMPLE.replace(
+            "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.02, 0.02] }",
+            "grc_min = { position = [0.05, 0, 0.06], size = [0.03, 0.03, 0.02] }",
+        ))
+        .unwrap();
+        let g = &cfg.grasp_types[0];
+        // A flat box, 60 × 50 × 25 mm, axes along the world's.
+        let ocp = Ocp {
+            region: 0,
+            center: Point3::new(0.5, -0.2, 1.0125),
+            rotation: Rotation3::identity(),
+            extents: Vector3::new(0.06, 0.05, 0.025),
+            blocked: [None; 6],
+        };
+        // Straight at the near side (−x), the 25 mm height is under GRCmin.
+        assert!(palm_targets(g, &ocp, BoxFace::NegX, None, None).is_empty());
+        // Turned 60° toward the top, the box measures 25 cos 60° + 60 sin 60°
+        // = 64 mm across the tilted palm axis: it fits.
+        let tilt = Tilt {
+            toward: BoxFace::PosZ,
+            angle: std::f64::consts::FRAC_PI_3,
+        };
+        let t = palm_targets(g, &ocp, BoxFace::NegX, Some(tilt), None);
+        assert!(!t.is_empty());
+        let (s, c) = tilt.angle.sin_cos();
+        for p in &t {
+            // The hand comes forward and down: −(n cos θ + n₂ sin θ).
+            let approach = p.palm.rotation * Vector3::z();
+            assert!(
+                (approach - Vector3::new(c, 0.0, -s)).norm() < 1e-9,
+                "{approach}"
+            );
+            // The box is shallower than GRCdes along the approach: GRCdes's
+            // centre stays on the box's.
+            let centre = p.palm * Point3::new(0.05, 0.0, 0.06);
+            assert!((centre - ocp.center).norm() < 1e-9);
+        }
     }
 }

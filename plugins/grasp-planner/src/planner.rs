@@ -46,10 +46,12 @@ use crate::clearance::{clear_nominal, max_lift, Surroundings};
 use crate::hand::HandModel;
 use crate::link_sets::LinkSets;
 use crate::object::PlanObject;
+use crate::ocp::Ocp;
 use crate::ocp::OcpParams;
 use crate::palm_pose::{criterion_value, palm_targets};
 use crate::search::{search, Counters, Found, Outcome, SearchContext, SearchParams};
-use crate::selection::{select, Candidate};
+use crate::selection::{select, Candidate, Selection};
+use crate::tilt::tilts;
 use crate::whole_body::{stages, StageJoints};
 
 /// The planner with its world (the kit's session), for in-process use.
@@ -189,8 +191,10 @@ impl GraspPlanner for Paper {
             last_stage: String::from("the arm"),
         };
         // The mass range's preferred types on every stage first, then the
-        // types that fit in size only (`Selection::fallback`).
-        for (tier, candidates) in [&selection.candidates, &selection.fallback]
+        // types that fit in size only (`Selection::fallback`), then both at
+        // an angle ([`crate::tilt`]).
+        let tilted = tilted(&selection, &ocps);
+        for (tier, candidates) in [&selection.candidates, &selection.fallback, &tilted]
             .into_iter()
             .enumerate()
         {
@@ -231,6 +235,24 @@ fn record_rejections(run: &mut Run, counters: &Counters) {
     }
 }
 
+/// Every candidate of `selection` (preferred types, then the fallback) at
+/// each of its face's tilts ([`crate::tilt::tilts`]).
+fn tilted(selection: &Selection, ocps: &[Ocp]) -> Vec<Candidate> {
+    selection
+        .candidates
+        .iter()
+        .chain(&selection.fallback)
+        .flat_map(|c| {
+            tilts(&ocps[c.region], c.face)
+                .into_iter()
+                .map(|t| Candidate {
+                    tilt: Some(t),
+                    ..c.clone()
+                })
+        })
+        .collect()
+}
+
 /// A deadline that never comes (no wall-clock limit was asked for).
 fn far_future() -> Instant {
     let now = Instant::now();
@@ -249,6 +271,7 @@ fn grasp(
         grasp_type,
         region: c.region,
         face: c.face,
+        tilt: c.tilt,
         q: found.q,
         joints: stage.joints.clone(),
         extra: stage.extra.clone(),
@@ -397,7 +420,7 @@ impl Paper {
             let g = &hand.config.grasp_types[cand.grasp_type];
             let links = LinkSets::for_type(hand, cand.grasp_type, &stage.extra);
             let ocp = &object.ocps[cand.region];
-            for target in palm_targets(g, ocp, cand.face, floor) {
+            for target in palm_targets(g, ocp, cand.face, cand.tilt, floor) {
                 run.check()?;
                 let mut q0 = q_init.clone();
                 hand.set_posture(cand.grasp_type, &mut q0);

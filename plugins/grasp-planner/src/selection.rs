@@ -30,6 +30,7 @@ use tsukami_msgs::planner::BoxFace;
 
 use crate::grasp_type::{GraspType, GrcBox};
 use crate::ocp::Ocp;
+use crate::tilt::Tilt;
 
 /// `sort(a)` of eq. (1): the elements in decreasing order.
 pub fn sorted(v: &Vector3<f64>) -> Vector3<f64> {
@@ -49,6 +50,9 @@ pub struct Candidate {
     pub face: BoxFace,
     /// Eq. (3): `‖sort(e_des) − sort(e_o)‖` (m).
     pub score: f64,
+    /// The approach turned toward a neighbour face ([`crate::tilt`]); `None`
+    /// for the paper's approach along the face normal.
+    pub tilt: Option<Tilt>,
 }
 
 /// Why a grasp type was not kept for a region or face.
@@ -174,6 +178,7 @@ pub fn select(types: &[GraspType], ocps: &[Ocp], mass: f64) -> Selection {
                 region: o.region,
                 face,
                 score,
+                tilt: None,
             }));
         }
     }
