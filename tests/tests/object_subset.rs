@@ -28,7 +28,7 @@ const T: Duration = Duration::from_secs(120);
 /// (object, placement): one of each family, on every placement, upright and
 /// lying, chosen among the cases the benchmark plans; the last two plan only
 /// with an approach at an angle (`tilt` in the reply).
-const SUBSET: [(&str, &str); 12] = [
+const SUBSET: [(&str, &str); 14] = [
     ("can_2", "table_0.78"),
     ("can_2", "table_0.72_lying"),
     ("bottle_0", "counter_1.00_rotated"),
@@ -39,15 +39,14 @@ const SUBSET: [(&str, &str); 12] = [
     ("scan_1", "stool_0.45"),
     ("mug_1", "counter_1.00_rotated"),
     ("low_0", "table_0.78"),
+    ("cone_1", "shelf_0.60"),
+    ("torus_1", "stool_0.45"),
     ("low_0", "counter_1.00_rotated"),
-    ("fruit_0", "table_0.72_lying"),
+    ("low_3", "shelf_0.60"),
 ];
 
 /// The cases of [`SUBSET`] no approach along the object box's axes holds.
-const TILTED: [(&str, &str); 2] = [
-    ("low_0", "counter_1.00_rotated"),
-    ("fruit_0", "table_0.72_lying"),
-];
+const TILTED: [(&str, &str); 2] = [("low_0", "counter_1.00_rotated"), ("low_3", "shelf_0.60")];
 
 /// A temporary model root, removed on drop.
 struct TempRoot(PathBuf);

@@ -252,6 +252,35 @@ impl TriangleMesh {
         m.vertices[n - 1] = Point3::new(0.0, 0.0, radius);
         m
     }
+
+    /// A closed torus lying on `z = 0` about the z axis: a tube of radius
+    /// `tube` swept along a circle of radius `ring` (`ring > tube`), with
+    /// `around` divisions along the ring and `across` around the tube.
+    pub fn torus(ring: f64, tube: f64, around: u32, across: u32) -> Self {
+        let (around, across) = (around.max(3), across.max(3));
+        let mut vertices = Vec::with_capacity((around * across) as usize);
+        for i in 0..around {
+            let a = std::f64::consts::TAU * i as f64 / around as f64;
+            for j in 0..across {
+                let b = std::f64::consts::TAU * j as f64 / across as f64;
+                let rho = ring + tube * b.cos();
+                vertices.push(Point3::new(
+                    rho * a.cos(),
+                    rho * a.sin(),
+                    tube * (1.0 + b.sin()),
+                ));
+            }
+        }
+        let at = |i: u32, j: u32| (i % around) * across + j % across;
+        let mut indices = Vec::with_capacity((2 * around * across) as usize);
+        for i in 0..around {
+            for j in 0..across {
+                let (p, q, u, v) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                indices.extend([[p, q, u], [p, u, v]]);
+            }
+        }
+        Self { vertices, indices }
+    }
 }
 
 #[cfg(test)]
@@ -271,6 +300,14 @@ mod tests {
         assert!(s.is_closed());
         let exact = 4.0 / 3.0 * std::f64::consts::PI * 1e-3;
         assert!((s.volume() - exact).abs() / exact < 0.03);
+        let t = TriangleMesh::torus(0.04, 0.015, 48, 16);
+        assert!(t.validate().is_ok());
+        assert!(t.is_closed());
+        // 2π² R r², and it rests on z = 0.
+        let exact = 2.0 * std::f64::consts::PI.powi(2) * 0.04 * 0.015f64.powi(2);
+        assert!((t.volume() - exact).abs() / exact < 0.03, "{}", t.volume());
+        let lowest = t.vertices.iter().map(|v| v.z).fold(f64::INFINITY, f64::min);
+        assert!(lowest.abs() < 1e-12);
     }
 
     #[test]

@@ -88,14 +88,30 @@ fn run_case(
     };
     if verbose {
         for o in &summary.regions {
+            let [x, y, z, w] = o.pose.quaternion;
+            let turn =
+                nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
+            // Each free face with its outward normal in the world.
+            let free: Vec<String> = o
+                .free_faces
+                .iter()
+                .map(|f| {
+                    let mut n = nalgebra::Vector3::zeros();
+                    n[f.axis()] = f.sign();
+                    let n = turn * n;
+                    format!("{} ({:+.2} {:+.2} {:+.2})", f.as_str(), n.x, n.y, n.z)
+                })
+                .collect();
             println!(
-                "    region {} extents [{:.3}, {:.3}, {:.3}] at {:?} free {:?}",
+                "    region {} extents [{:.3}, {:.3}, {:.3}] at [{:.3}, {:.3}, {:.3}] free {}",
                 o.region,
                 o.extents[0],
                 o.extents[1],
                 o.extents[2],
-                o.pose.position,
-                o.free_faces.iter().map(|f| f.as_str()).collect::<Vec<_>>()
+                o.pose.position[0],
+                o.pose.position[1],
+                o.pose.position[2],
+                free.join(", ")
             );
         }
     }
@@ -151,7 +167,12 @@ fn describe(r: &PlanReply) -> String {
         ),
         None => String::new(),
     };
-    format!("{} face {}{tilt}", r.grasp_type.name, r.face.as_str())
+    format!(
+        "{} region {} face {}{tilt}",
+        r.grasp_type.name,
+        r.ocp_region,
+        r.face.as_str()
+    )
 }
 
 fn report(outcomes: &[Outcome]) {

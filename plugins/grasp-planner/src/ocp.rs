@@ -17,10 +17,14 @@
 //! Axes whose eigenvalues coincide (the cross-section of a cylinder) are not
 //! determined by the surface: [`OcpParams::preferred_axis`] picks them, so a
 //! can's side faces look toward the robot. Regions: the radius profile of
-//! cross-sections along the longest axis is cut where it jumps and where a
-//! region's radius range grows too wide; similar neighbouring runs are merged
-//! back unless the merged run would be that wide again (a vase's flared lip,
-//! its neck and its body stay three regions). Everything is pure over nalgebra values.
+//! cross-sections along the longest axis (of equally long ones, the first:
+//! toward the robot) is cut where it jumps and where a region's radius range
+//! grows too wide; similar neighbouring runs are merged back unless the merged
+//! run would be that wide again (a vase's flared lip, its neck and its body
+//! stay three regions). Where the axis leaves the material for a hole (the
+//! parity of a ray in each cross-section) the cut is there instead: a ring
+//! lying flat becomes its near arc, its middle with the hole and its far arc,
+//! each arc holding the whole tube. Everything is pure over nalgebra values.
 //!
 //! ```
 //! use nalgebra::Point3;
@@ -39,6 +43,10 @@
 
 use nalgebra::{Matrix3, Point3, Rotation3, SymmetricEigen, UnitQuaternion, Vector3};
 use tsukami_msgs::planner::{BoxFace, FaceBlock, OcpBox, Pose};
+
+/// Box axes whose extents differ by less than this fraction of the longest
+/// count as equally long when choosing the axis to split along.
+const LONGEST_TIE: f64 = 0.02;
 
 /// Parameters of the OCP computation.
 #[derive(Debug, Clone)]
@@ -347,34 +355,95 @@ fn clip(poly: &[Vector3<f64>], axis: &Vector3<f64>, t: f64, keep_above: bool) ->
     out
 }
 
-/// Radius of the cross-section of the surface by the plane `axis·x = t`:
-/// the largest distance of a section point from the line through `center` along `axis`.
-fn section_radius(
+/// One cross-section of the surface by the plane `axis·x = t`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Section {
+    /// The largest distance of a section point from the line through the
+    /// box centre along `axis`.
+    radius: f64,
+    /// Whether that line passes through material here (an odd number of the
+    /// section's segments cross a ray from it in the plane), not through a
+    /// hole: false in the middle of a ring lying flat.
+    pierced: bool,
+}
+
+/// The cross-section at `t`; `ray` is a unit direction across `axis` (the
+/// parity ray, chosen off the box's axes).
+fn section(
     tris: &[[Vector3<f64>; 3]],
     axis: &Vector3<f64>,
     center: &Vector3<f64>,
     t: f64,
-) -> f64 {
-    let mut r: f64 = 0.0;
-    let radial = |p: Vector3<f64>| {
-        let d = p - center;
-        (d - axis * axis.dot(&d)).norm()
-    };
+    ray: &Vector3<f64>,
+) -> Section {
+    let on_line = center + axis * (t - axis.dot(center));
+    let across = axis.cross(ray);
+    let (mut r, mut crossings): (f64, u32) = (0.0, 0);
     for tri in tris {
         let d = [
             axis.dot(&tri[0]) - t,
             axis.dot(&tri[1]) - t,
             axis.dot(&tri[2]) - t,
         ];
+        let mut ends = [Vector3::zeros(); 2];
+        let mut n = 0;
         for e in 0..3 {
             let (i, j) = (e, (e + 1) % 3);
             if (d[i] >= 0.0) != (d[j] >= 0.0) {
                 let s = d[i] / (d[i] - d[j]);
-                r = r.max(radial(tri[i] + (tri[j] - tri[i]) * s));
+                let q = tri[i] + (tri[j] - tri[i]) * s;
+                let from_centre = q - center;
+                r = r.max((from_centre - axis * axis.dot(&from_centre)).norm());
+                if n < 2 {
+                    ends[n] = q - on_line;
+                }
+                n += 1;
+            }
+        }
+        if n == 2 {
+            // Does the segment cross the ray `on_line + s·ray`, s > 0?
+            let (a, b) = (across.dot(&ends[0]), across.dot(&ends[1]));
+            if (a >= 0.0) != (b >= 0.0) {
+                let (sa, sb) = (ray.dot(&ends[0]), ray.dot(&ends[1]));
+                if sa + (sb - sa) * a / (a - b) > 0.0 {
+                    crossings += 1;
+                }
             }
         }
     }
-    r
+    Section {
+        radius: r,
+        pierced: crossings % 2 == 1,
+    }
+}
+
+/// Splits the slices `0..flags.len()` where the split axis goes from
+/// material into a hole or back (a ring lying flat: its near arc, the middle
+/// with the hole, its far arc), ignoring runs shorter than `min_len` slices
+/// (merged into the run before, or after for the first), so a stray parity
+/// flip of an untidy mesh cuts nothing.
+fn hole_runs(flags: &[bool], min_len: usize) -> Vec<std::ops::Range<usize>> {
+    let mut runs: Vec<(std::ops::Range<usize>, bool)> = Vec::new();
+    for (k, &f) in flags.iter().enumerate() {
+        match runs.last_mut() {
+            Some((r, g)) if *g == f => r.end = k + 1,
+            _ => runs.push((k..k + 1, f)),
+        }
+    }
+    // Short runs join a neighbour; neighbours with the same flag then join.
+    let mut out: Vec<(std::ops::Range<usize>, bool)> = Vec::new();
+    for (r, f) in runs {
+        match out.last_mut() {
+            Some((prev, _)) if r.len() < min_len => prev.end = r.end,
+            Some((prev, g)) if *g == f => prev.end = r.end,
+            Some((prev, _)) if prev.len() < min_len => {
+                prev.end = r.end;
+                out.last_mut().expect("just matched").1 = f;
+            }
+            _ => out.push((r, f)),
+        }
+    }
+    out.into_iter().map(|(r, _)| r).collect()
 }
 
 /// Cuts the radius profile into runs of similar radius; returns slice index ranges.
@@ -498,8 +567,13 @@ pub fn object_ocps(
         return Vec::new();
     };
     let global = tighten(global, &whole, vertices, params);
-    // Split along the longest box axis.
-    let long = global.extents.imax();
+    // Split along the longest box axis; of axes equally long (within
+    // `LONGEST_TIE`), the first: the preferred one of a symmetric pair (a
+    // ring lying flat splits into its near arc, middle and far arc).
+    let longest = global.extents.max();
+    let long = (0..3)
+        .find(|&k| global.extents[k] >= (1.0 - LONGEST_TIE) * longest)
+        .unwrap_or(0);
     let axis = global.rotation.matrix().column(long).into_owned();
     let center = global.center.coords;
     let (t0, t1) = {
@@ -510,13 +584,26 @@ pub fn object_ocps(
         )
     };
     let n = params.slices.max(1);
-    let radii: Vec<f64> = (0..n)
+    let m = global.rotation.matrix();
+    let (u, v) = (m.column((long + 1) % 3), m.column((long + 2) % 3));
+    // The parity ray, off the box's axes and diagonals.
+    let ray = (u * 0.37f64.cos() + v * 0.37f64.sin()).normalize();
+    let sections: Vec<Section> = (0..n)
         .map(|k| {
             let t = t0 + (k as f64 + 0.5) / n as f64 * (t1 - t0);
-            section_radius(&tris, &axis, &center, t)
+            section(&tris, &axis, &center, t, &ray)
         })
         .collect();
-    let runs = segment_profile(&radii, params);
+    let radii: Vec<f64> = sections.iter().map(|s| s.radius).collect();
+    let flags: Vec<bool> = sections.iter().map(|s| s.pierced).collect();
+    let min_len = ((params.min_region_fraction * n as f64).ceil() as usize).max(1);
+    // Where the axis enters or leaves a hole is the cut (a ring lying flat:
+    // near arc, middle, far arc; the radius profile means nothing across a
+    // hole); without a hole, the paper's radius profile cuts.
+    let runs = match hole_runs(&flags, min_len) {
+        parts if parts.len() > 1 => parts,
+        _ => segment_profile(&radii, params),
+    };
     let mut ocps = if runs.len() <= 1 {
         vec![global]
     } else {
@@ -666,6 +753,51 @@ mod tests {
             Some(FaceBlock::Support)
         );
         assert_eq!(o.free_faces().count(), 5);
+    }
+
+    #[test]
+    fn a_ring_lying_flat_splits_at_its_hole_into_near_arc_middle_and_far_arc() {
+        // A roll of tape: ring 40 mm, tube 15 mm, lying on a table at 0.75 m.
+        let mesh = tsukami_body::mesh::TriangleMesh::torus(0.04, 0.015, 48, 16);
+        let v: Vec<Point3<f64>> = mesh
+            .vertices
+            .iter()
+            .map(|p| p + Vector3::new(0.5, -0.2, 0.75))
+            .collect();
+        let mut ocps = object_ocps(&v, &mesh.indices, &OcpParams::default());
+        assert_eq!(ocps.len(), 3, "{ocps:?}");
+        ocps.sort_by(|a, b| a.center.x.total_cmp(&b.center.x));
+        // Split toward the robot (world x): the arcs hold the whole tube,
+        // 30 mm from its outer to its inner side; the middle spans the hole.
+        let along_x = |o: &Ocp| {
+            let m = o.rotation.matrix();
+            (0..3).map(|k| m[(0, k)].abs() * o.extents[k]).sum::<f64>()
+        };
+        let (near, middle, far) = (&ocps[0], &ocps[1], &ocps[2]);
+        for arc in [near, far] {
+            assert!((along_x(arc) - 0.03).abs() < 2e-3, "{arc:?}");
+        }
+        assert!((along_x(middle) - 0.05).abs() < 2e-3, "{middle:?}");
+        // The near arc can be taken from the top and from the robot's side.
+        for n in [Vector3::z(), -Vector3::x()] {
+            assert!(near
+                .free_faces()
+                .any(|f| near.face_normal(f).dot(&n) > 0.99));
+        }
+    }
+
+    #[test]
+    fn short_parity_flips_cut_nothing() {
+        let (t, f) = (true, false);
+        // Material, hole, material: three parts.
+        let flags = [t, t, t, t, f, f, f, f, f, t, t, t, t];
+        assert_eq!(hole_runs(&flags, 3), vec![0..4, 4..9, 9..13]);
+        // A one-slice flip (an untidy mesh) joins its neighbours.
+        let flags = [t, t, t, t, f, t, t, t, t, t];
+        assert_eq!(hole_runs(&flags, 3), vec![0..10]);
+        // A short run at the start joins the next.
+        let flags = [f, t, t, t, t, t];
+        assert_eq!(hole_runs(&flags, 3), vec![0..6]);
     }
 
     #[test]

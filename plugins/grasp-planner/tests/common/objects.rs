@@ -1,8 +1,9 @@
 //! The object benchmark's objects and placements (issue #10), generated
-//! procedurally so nothing large is committed: 45 everyday objects in 9 shape
+//! procedurally so nothing large is committed: 55 everyday objects in 11 shape
 //! families — cans, bottles, mugs whose handle touches the body along an edge
 //! (closed but non-manifold), boxes, fruit, spray cans, vases, noisy open
-//! "scans", and low flat objects (a thin plate among them) —
+//! "scans", cones (cups, a nearly pointed one), tori lying flat (rings,
+//! doughnuts, rolls of tape), and low flat objects (a thin plate among them) —
 //! each with a mass, and 5 placements on supports given as obstacles: a 0.78 m
 //! table, a 1.00 m counter (rotated), a 0.45 m stool, lying on a 0.72 m table,
 //! and an open shelf with a board above.
@@ -152,7 +153,7 @@ pub fn scan(mut base: TriangleMesh, amp: f64, salt: u64, miswound: bool) -> Tria
     base
 }
 
-/// The 45 objects.
+/// The 55 objects.
 pub fn objects() -> Vec<BenchObject> {
     let mut out = Vec::new();
     let mut add = |family: &'static str, mesh: TriangleMesh, mass: f64, flat: bool| {
@@ -240,6 +241,24 @@ pub fn objects() -> Vec<BenchObject> {
     ];
     for (k, base) in scans.into_iter().enumerate() {
         add("scan", scan(base, 0.0008, k as u64, false), 0.3, false);
+    }
+    for (rb, rt, h, m) in [
+        (0.035, 0.02, 0.12, 0.2),
+        (0.03, 0.004, 0.1, 0.12),
+        (0.025, 0.042, 0.11, 0.15),
+        (0.045, 0.03, 0.09, 0.25),
+        (0.02, 0.035, 0.15, 0.2),
+    ] {
+        add("cone", lathe(&[(rb, 0.0), (rt, h)]), m, false);
+    }
+    for (big, r, m) in [
+        (0.035, 0.012, 0.1),
+        (0.04, 0.015, 0.15),
+        (0.03, 0.01, 0.08),
+        (0.045, 0.02, 0.25),
+        (0.05, 0.012, 0.12),
+    ] {
+        add("torus", TriangleMesh::torus(big, r, 48, 16), m, true);
     }
     add("low", cuboid([0.10, 0.07, 0.025]), 0.15, true);
     add("low", TriangleMesh::cylinder(0.042, 0.035, 32), 0.18, true);
