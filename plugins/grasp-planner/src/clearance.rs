@@ -7,6 +7,8 @@
 //! [`LIFT_STEP`] along the world vertical, up to [`max_lift`] of the OCP,
 //! until it is clear; at the highest lift, a finger still on an obstacle is
 //! flexed instead ([`PRE_FLEX`]: its Δa_i joints, toward their upper limits).
+//! A finger that rests on the object itself in the reference posture is
+//! opened instead ([`PRE_OPEN`]: its closing joint, toward its lower limit).
 //! It returns the first clear pose, or the unlifted one marked blocked.
 //!
 //! Why: the paper centres GRCdes on the OCP, which on a low or lying object
@@ -19,7 +21,9 @@
 //! itself (the upper arm in the chest) or against the object triggers the IK
 //! again from other arm postures ([`ARM_STARTS`]), which a lift would not
 //! change; a hand link on the object triggers neither (the palm pose places
-//! the hand, whatever the arm does). A lift whose IK fails is skipped. The
+//! the hand, whatever the arm does) but, when it is a closing finger's, that
+//! finger opens (the Allegro's fingertip posture is narrower than a ring's
+//! tube with the fingertips' thickness). A lift whose IK fails is skipped. The
 //! unlifted pose and the usual IK start are tried first, so a scene whose
 //! nominal is already clear is unchanged.
 //!
@@ -199,6 +203,58 @@ fn pre_flex(
     None
 }
 
+/// How far a finger that touches the object in the pre-shape is opened
+/// before sampling: fractions of the way from its closing joint's value to
+/// the joint's lower limit, tried in turn.
+pub const PRE_OPEN: [f64; 3] = [0.25, 0.5, 0.75];
+
+/// `q` with every finger that touches the object at the pre-shape opened
+/// (its contact's closing joint turned back, by the first [`PRE_OPEN`]
+/// fraction that frees it), so that the closing starts outside the object:
+/// a wider hand than the reference posture, as a person opens the hand more
+/// for a thick part. `None` if a link other than a closing finger's touches,
+/// or no fraction frees the finger.
+fn pre_open(
+    hand: &HandModel,
+    links: &LinkSets,
+    t: usize,
+    q: &[f64],
+    around: &Surroundings<'_>,
+    fk: &mut FkState,
+) -> Option<Vec<f64>> {
+    let mut q = q.to_vec();
+    // Each finger at most once.
+    for _ in 0..hand.types[t].contacts.len() {
+        hand.robot.forward_kinematics(&q, fk);
+        let hit = match links.blocked_by(hand, fk, around.object, around.env, true) {
+            None => return Some(q),
+            Some(b) if b.against == Against::Object => b.link,
+            Some(_) => return None,
+        };
+        let finger = hand.types[t]
+            .contacts
+            .iter()
+            .find(|c| crate::finger_closing::moved_links(hand, c.joint, c.link).contains(&hit))?;
+        let (j, lower) = (finger.joint, hand.robot.joints[finger.joint].limits.lower);
+        if !lower.is_finite() || lower >= q[j] {
+            return None;
+        }
+        let freed = PRE_OPEN.iter().find_map(|f| {
+            let mut opened = q.clone();
+            opened[j] = q[j] - f * (q[j] - lower);
+            hand.robot.apply_mimics(&mut opened);
+            hand.robot.forward_kinematics(&opened, fk);
+            let still = links
+                .blocked_by(hand, fk, around.object, around.env, true)
+                .is_some_and(|b| b.link == hit);
+            (!still).then_some(opened)
+        })?;
+        q = freed;
+    }
+    hand.robot.forward_kinematics(&q, fk);
+    (verdict(hand, links, fk, around) == Verdict::Clear).then_some(q)
+}
+
 /// The nominal `palm`, lifted as little as [`LIFT_STEP`] steps up to `lift`
 /// allow so that `links` clear `around` (see the module docs); `None` when
 /// the unlifted pose has no IK solution. `q0` holds the grasp type's posture.
@@ -241,7 +297,18 @@ pub fn clear_nominal(
             q: q.clone(),
             blocked,
         });
-        if matches!(v, Verdict::Other | Verdict::HandOnObject) {
+        if v == Verdict::HandOnObject {
+            // A finger on the object: open it rather than move the hand.
+            if let Some(q) = pre_open(hand, links, t, &q, around, fk) {
+                return Some(Cleared {
+                    palm: p,
+                    q,
+                    blocked: false,
+                });
+            }
+            return first;
+        }
+        if v == Verdict::Other {
             return first;
         }
         highest = Some((p, q));

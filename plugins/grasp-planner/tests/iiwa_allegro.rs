@@ -5,6 +5,9 @@
 //! passes the independent check (`tsukami_scenes::verify`: exact force
 //! closure with the object's weight, no penetration, contacts on the hand).
 
+#[path = "common/objects.rs"]
+mod objects;
+
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -76,4 +79,43 @@ fn the_iiwa_with_the_allegro_hand_plans_verified_grasps_of_a_can() {
             assert_verified(&object, &env, &reply);
         }
     }
+}
+
+/// The Allegro's reference fingertip posture is narrower than a ring's tube
+/// with the fingertips' thickness: at every nominal palm pose over the ring
+/// a fingertip rests on it. The planner opens that finger before sampling
+/// (`clearance::PRE_OPEN`) and the grasp is planned and verified; without
+/// the opening, every sample collides before closing.
+#[test]
+fn a_finger_on_the_ring_in_the_pre_shape_is_opened_and_the_ring_is_grasped() {
+    let dir = std::env::temp_dir().join(format!("tsukami-allegro-ring-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = std::fs::canonicalize(&dir).unwrap();
+    let p = Planner::from_config(tsukami_planner_kit::PlannerConfig::with_roots([
+        models(),
+        root.clone(),
+    ]))
+    .unwrap();
+    p.set_robot(&robot()).unwrap();
+    let ring = objects::objects()
+        .into_iter()
+        .find(|o| o.name == "torus_1")
+        .unwrap();
+    let counter = objects::placements()
+        .into_iter()
+        .find(|p| p.name == "counter_1.00_rotated")
+        .unwrap();
+    let path = root.join("ring.stl");
+    ring.mesh.write_stl(&path).unwrap();
+    let object: SetObject = serde_json::from_value(objects::set_object(
+        &ring,
+        &counter,
+        &path.display().to_string(),
+    ))
+    .unwrap();
+    let env: SetEnv = serde_json::from_value(objects::set_env(&counter)).unwrap();
+    let reply = plan(&p, &object, &env, 1);
+    assert_verified(&object, &env, &reply);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(reply.force_closure.exact_resists_weight);
 }
