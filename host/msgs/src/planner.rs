@@ -414,7 +414,7 @@ pub struct PlanOptions {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grasp_types: Option<Vec<String>>,
     /// Maximum number of nominal palm poses (grasp type × OCP face × rotation)
-    /// searched per whole-body stage, best first (default 6).
+    /// searched per whole-body stage, best first (default 8).
     #[serde(default = "default_max_candidates")]
     pub max_candidates: u32,
 }
@@ -423,7 +423,7 @@ fn default_max_samples() -> u32 {
     1000
 }
 fn default_max_candidates() -> u32 {
-    6
+    8
 }
 
 impl Default for PlanOptions {
