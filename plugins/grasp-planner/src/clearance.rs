@@ -46,8 +46,9 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 use tsukami_body::collision::CollisionObject;
 use tsukami_body::ik::IkSolver;
 use tsukami_body::kinematics::FkState;
+use tsukami_body::model::LinkId;
 
-use crate::hand::HandModel;
+use crate::hand::{HandModel, ResolvedContact};
 use crate::link_sets::{Against, LinkSets};
 use crate::ocp::Ocp;
 
@@ -166,93 +167,95 @@ fn solve(
 /// limits, tried in turn.
 pub const PRE_FLEX: [f64; 3] = [0.3, 0.6, 0.9];
 
-/// `q` with the finger that touches an obstacle flexed (its contact's
-/// `perturb` joints, the ones Δa_i moves) by the first [`PRE_FLEX`] fraction
-/// that clears `around`; `None` if none does, or if no finger is the one
-/// touching.
-fn pre_flex(
-    hand: &HandModel,
-    links: &LinkSets,
-    t: usize,
-    q: &[f64],
-    around: &Surroundings<'_>,
-    fk: &mut FkState,
-) -> Option<Vec<f64>> {
-    hand.robot.forward_kinematics(q, fk);
-    let hit = hand
-        .collision
-        .first_collision(fk, &links.moving, around.env, 0.0)?;
-    let finger = hand.types[t]
-        .contacts
-        .iter()
-        .find(|c| crate::finger_closing::moved_links(hand, c.joint, c.link).contains(&hit.link))?;
-    for f in PRE_FLEX {
-        let mut flexed = q.to_vec();
-        for &j in &finger.perturb {
-            let upper = hand.robot.joints[j].limits.upper;
-            if upper.is_finite() && upper > q[j] {
-                flexed[j] = q[j] + f * (upper - q[j]);
-            }
-        }
-        hand.robot.apply_mimics(&mut flexed);
-        hand.robot.forward_kinematics(&flexed, fk);
-        if verdict(hand, links, fk, around) == Verdict::Clear {
-            return Some(flexed);
-        }
-    }
-    None
-}
-
 /// How far a finger that touches the object in the pre-shape is opened
 /// before sampling: fractions of the way from its closing joint's value to
 /// the joint's lower limit, tried in turn.
 pub const PRE_OPEN: [f64; 3] = [0.25, 0.5, 0.75];
 
-/// `q` with every finger that touches the object at the pre-shape opened
-/// (its contact's closing joint turned back, by the first [`PRE_OPEN`]
-/// fraction that frees it), so that the closing starts outside the object:
-/// a wider hand than the reference posture, as a person opens the hand more
-/// for a thick part. `None` if a link other than a closing finger's touches,
-/// or no fraction frees the finger.
-fn pre_open(
-    hand: &HandModel,
-    links: &LinkSets,
+/// The pre-shape of grasp type `t` at a nominal palm pose, and what its
+/// fingers may be moved away from.
+struct PreShape<'a> {
+    hand: &'a HandModel,
+    links: &'a LinkSets,
     t: usize,
-    q: &[f64],
-    around: &Surroundings<'_>,
-    fk: &mut FkState,
-) -> Option<Vec<f64>> {
-    let mut q = q.to_vec();
-    // Each finger at most once.
-    for _ in 0..hand.types[t].contacts.len() {
-        hand.robot.forward_kinematics(&q, fk);
-        let hit = match links.blocked_by(hand, fk, around.object, around.env, true) {
-            None => return Some(q),
-            Some(b) if b.against == Against::Object => b.link,
-            Some(_) => return None,
-        };
-        let finger = hand.types[t]
+    around: &'a Surroundings<'a>,
+}
+
+impl PreShape<'_> {
+    /// The contact whose finger moves `link` when it closes.
+    fn finger_of(&self, link: LinkId) -> Option<&ResolvedContact> {
+        let hand = self.hand;
+        hand.types[self.t]
             .contacts
             .iter()
-            .find(|c| crate::finger_closing::moved_links(hand, c.joint, c.link).contains(&hit))?;
-        let (j, lower) = (finger.joint, hand.robot.joints[finger.joint].limits.lower);
-        if !lower.is_finite() || lower >= q[j] {
-            return None;
-        }
-        let freed = PRE_OPEN.iter().find_map(|f| {
-            let mut opened = q.clone();
-            opened[j] = q[j] - f * (q[j] - lower);
-            hand.robot.apply_mimics(&mut opened);
-            hand.robot.forward_kinematics(&opened, fk);
-            let still = links
-                .blocked_by(hand, fk, around.object, around.env, true)
-                .is_some_and(|b| b.link == hit);
-            (!still).then_some(opened)
-        })?;
-        q = freed;
+            .find(|c| crate::finger_closing::moved_links(hand, c.joint, c.link).contains(&link))
     }
-    hand.robot.forward_kinematics(&q, fk);
-    (verdict(hand, links, fk, around) == Verdict::Clear).then_some(q)
+
+    /// Whether `q` (with its mimics applied) clears everything.
+    fn clear(&self, q: &mut [f64], fk: &mut FkState) -> bool {
+        self.hand.robot.apply_mimics(q);
+        self.hand.robot.forward_kinematics(q, fk);
+        verdict(self.hand, self.links, fk, self.around) == Verdict::Clear
+    }
+
+    /// `q` with the finger that touches an obstacle flexed (its contact's
+    /// `perturb` joints, the ones Δa_i moves) by the first [`PRE_FLEX`]
+    /// fraction that clears everything; `None` if none does, or if no finger
+    /// is the one touching.
+    fn flex(&self, q: &[f64], fk: &mut FkState) -> Option<Vec<f64>> {
+        let robot = &self.hand.robot;
+        robot.forward_kinematics(q, fk);
+        let hit =
+            self.hand
+                .collision
+                .first_collision(fk, &self.links.moving, self.around.env, 0.0)?;
+        let finger = self.finger_of(hit.link)?;
+        PRE_FLEX.iter().find_map(|f| {
+            let mut flexed = q.to_vec();
+            for &j in &finger.perturb {
+                let upper = robot.joints[j].limits.upper;
+                if upper.is_finite() && upper > q[j] {
+                    flexed[j] = q[j] + f * (upper - q[j]);
+                }
+            }
+            self.clear(&mut flexed, fk).then_some(flexed)
+        })
+    }
+
+    /// `q` with every finger that touches the object opened (its contact's
+    /// closing joint turned back by the first [`PRE_OPEN`] fraction that
+    /// frees it), so that the closing starts outside the object: a wider
+    /// hand than the reference posture, as a person opens the hand more for
+    /// a thick part. `None` if a link other than a closing finger's touches
+    /// or no fraction frees the finger.
+    fn open(&self, q: &[f64], fk: &mut FkState) -> Option<Vec<f64>> {
+        let (hand, links, around) = (self.hand, self.links, self.around);
+        let on_object = |fk: &FkState| links.blocked_by(hand, fk, around.object, around.env, true);
+        let mut q = q.to_vec();
+        // Each finger at most once.
+        for _ in 0..hand.types[self.t].contacts.len() {
+            hand.robot.forward_kinematics(&q, fk);
+            let hit = match on_object(fk) {
+                None => return Some(q),
+                Some(b) if b.against == Against::Object => b.link,
+                Some(_) => return None,
+            };
+            let j = self.finger_of(hit)?.joint;
+            let lower = hand.robot.joints[j].limits.lower;
+            if !lower.is_finite() || lower >= q[j] {
+                return None;
+            }
+            q = PRE_OPEN.iter().find_map(|f| {
+                let mut opened = q.clone();
+                opened[j] = q[j] - f * (q[j] - lower);
+                hand.robot.apply_mimics(&mut opened);
+                hand.robot.forward_kinematics(&opened, fk);
+                let still = on_object(fk).is_some_and(|b| b.link == hit);
+                (!still).then_some(opened)
+            })?;
+        }
+        self.clear(&mut q, fk).then_some(q)
+    }
 }
 
 /// The nominal `palm`, lifted as little as [`LIFT_STEP`] steps up to `lift`
@@ -270,6 +273,12 @@ pub fn clear_nominal(
     fk: &mut FkState,
 ) -> Option<Cleared> {
     let steps = (lift / LIFT_STEP).floor() as usize;
+    let shape = PreShape {
+        hand,
+        links,
+        t,
+        around,
+    };
     let mut first: Option<Cleared> = None;
     let mut highest: Option<(Isometry3<f64>, Vec<f64>)> = None;
     for k in 0..=steps {
@@ -299,7 +308,7 @@ pub fn clear_nominal(
         });
         if v == Verdict::HandOnObject {
             // A finger on the object: open it rather than move the hand.
-            if let Some(q) = pre_open(hand, links, t, &q, around, fk) {
+            if let Some(q) = shape.open(&q, fk) {
                 return Some(Cleared {
                     palm: p,
                     q,
@@ -315,7 +324,7 @@ pub fn clear_nominal(
     }
     // Lifted as far as allowed and a finger still on an obstacle: flex it.
     if let Some((p, q)) = highest {
-        if let Some(q) = pre_flex(hand, links, t, &q, around, fk) {
+        if let Some(q) = shape.flex(&q, fk) {
             return Some(Cleared {
                 palm: p,
                 q,

@@ -184,26 +184,37 @@ mod tests {
     use crate::grasp_type::GraspTypeConfig;
     use nalgebra::Point3;
 
+    /// The one-type example with GRCmin of `size`.
+    fn with_grc_min(size: [f64; 3]) -> GraspTypeConfig {
+        GraspTypeConfig::from_toml_str(&crate::grasp_type::ONE_TYPE_EXAMPLE.replace(
+            "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.02, 0.02] }",
+            &format!("grc_min = {{ position = [0.05, 0, 0.06], size = {size:?} }}"),
+        ))
+        .unwrap()
+    }
+
+    /// A free box of `extents` at `center` with axes `rotation`.
+    fn free_box(center: [f64; 3], rotation: Rotation3<f64>, extents: [f64; 3]) -> Ocp {
+        Ocp {
+            region: 0,
+            center: Point3::from(center),
+            rotation,
+            extents: Vector3::from(extents),
+            blocked: [None; 6],
+        }
+    }
+
     #[test]
     fn approach_points_into_the_face_and_rotations_are_filtered() {
-        let cfg = GraspTypeConfig::from_toml_str(&crate::grasp_type::ONE_TYPE_EXAMPLE.replace(
-            "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.02, 0.02] }",
-            "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.09, 0.02] }",
-        ))
-        .unwrap();
+        let cfg = with_grc_min([0.02, 0.09, 0.02]);
         let g = &cfg.grasp_types[0];
         // A can standing at (0.5, 0, 1.061); axis 0 vertical.
-        let ocp = Ocp {
-            region: 0,
-            center: Point3::new(0.5, 0.0, 1.061),
-            rotation: Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[
-                Vector3::z(),
-                -Vector3::x(),
-                -Vector3::y(),
-            ])),
-            extents: Vector3::new(0.122, 0.066, 0.066),
-            blocked: [None; 6],
-        };
+        let axes = Matrix3::from_columns(&[Vector3::z(), -Vector3::x(), -Vector3::y()]);
+        let ocp = free_box(
+            [0.5, 0.0, 1.061],
+            Rotation3::from_matrix_unchecked(axes),
+            [0.122, 0.066, 0.066],
+        );
         // Face +y of the box = world −x: facing the robot.
         let t = palm_targets(g, &ocp, BoxFace::PosY, None, None);
         // GRCmin's palm-y edge (0.09) only fits along the can's height: 2 of 4 rotations.
@@ -224,20 +235,14 @@ mod tests {
     #[test]
     fn a_tilted_approach_comes_between_two_faces_and_measures_by_projection() {
         // GRCmin 30 mm across both palm axes: wider than the box is tall.
-        let cfg = GraspTypeConfig::from_toml_str(&crate::grasp_type::ONE_TYPE_EXAMPLE.replace(
-            "grc_min = { position = [0.05, 0, 0.06], size = [0.02, 0.02, 0.02] }",
-            "grc_min = { position = [0.05, 0, 0.06], size = [0.03, 0.03, 0.02] }",
-        ))
-        .unwrap();
+        let cfg = with_grc_min([0.03, 0.03, 0.02]);
         let g = &cfg.grasp_types[0];
         // A flat box, 60 × 50 × 25 mm, axes along the world's.
-        let ocp = Ocp {
-            region: 0,
-            center: Point3::new(0.5, -0.2, 1.0125),
-            rotation: Rotation3::identity(),
-            extents: Vector3::new(0.06, 0.05, 0.025),
-            blocked: [None; 6],
-        };
+        let ocp = free_box(
+            [0.5, -0.2, 1.0125],
+            Rotation3::identity(),
+            [0.06, 0.05, 0.025],
+        );
         // Straight at the near side (−x), the 25 mm height is under GRCmin.
         assert!(palm_targets(g, &ocp, BoxFace::NegX, None, None).is_empty());
         // Turned 60° toward the top, the box measures 25 cos 60° + 60 sin 60°
