@@ -1,5 +1,5 @@
-//! The object benchmark of issue #10: 45 procedurally generated everyday
-//! objects in 9 shape families × 5 placements on supports (see
+//! The object benchmark of issue #10: 55 procedurally generated everyday
+//! objects in 11 shape families × 5 placements on supports (see
 //! `tests/common/objects.rs`), each planned with the same seed and every
 //! returned grasp verified INDEPENDENTLY by `tsukami_scenes::verify` (exact
 //! force closure with the weight recomputed from the reply's contacts, contacts
