@@ -198,3 +198,21 @@ fn a_million_triangle_binary_stl_loads_and_plans() {
     assert_verified(&req, &env, &r);
     std::fs::remove_file(&path).unwrap();
 }
+
+/// A 10 mm pen standing on the counter: thinner than the 12 mm the small
+/// fingertip types once required (refused as `no_grasp_type`); the thumb tip
+/// and the finger tips meet, and the grasp is planned and verified.
+#[test]
+fn a_pen_thinner_than_a_finger_is_planned() {
+    let p = planner();
+    let o = object("pen", TriangleMesh::cylinder(0.005, 0.14, 24), 0.02);
+    let path = tmp_dir().join("pen.stl");
+    o.mesh.write_stl(&path).unwrap();
+    let (_, r, req, env) = set_and_plan(&p, &o, &path, 1);
+    assert!(
+        r.grasp_type.name.ends_with("_small"),
+        "{}",
+        r.grasp_type.name
+    );
+    assert_verified(&req, &env, &r);
+}
