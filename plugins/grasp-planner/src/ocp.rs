@@ -542,6 +542,70 @@ fn segment_profile(radii: &[f64], params: &OcpParams) -> Vec<std::ops::Range<usi
     runs
 }
 
+/// Where the object's box is cut into regions: along `axis`, between
+/// `t0` and `t1`, into runs of `n` slices.
+struct Split {
+    axis: Vector3<f64>,
+    t0: f64,
+    t1: f64,
+    n: usize,
+    runs: Vec<std::ops::Range<usize>>,
+}
+
+impl Split {
+    /// The cuts of the box `global` around the triangles `tris`.
+    fn of(tris: &[[Vector3<f64>; 3]], global: &Ocp, params: &OcpParams) -> Split {
+        // Split along the longest box axis; of axes equally long (within
+        // `LONGEST_TIE`), the first: the preferred one of a symmetric pair (a
+        // ring lying flat splits into its near arc, middle and far arc).
+        let longest = global.extents.max();
+        let long = (0..3)
+            .find(|&k| global.extents[k] >= (1.0 - LONGEST_TIE) * longest)
+            .unwrap_or(0);
+        let m = global.rotation.matrix();
+        let axis = m.column(long).into_owned();
+        let center = global.center.coords;
+        let c = axis.dot(&center);
+        let (t0, t1) = (
+            c - 0.5 * global.extents[long],
+            c + 0.5 * global.extents[long],
+        );
+        let n = params.slices.max(1);
+        let (u, v) = (m.column((long + 1) % 3), m.column((long + 2) % 3));
+        // The parity ray, off the box's axes and diagonals.
+        let ray = (u * 0.37f64.cos() + v * 0.37f64.sin()).normalize();
+        let sections: Vec<Section> = (0..n)
+            .map(|k| {
+                let t = t0 + (k as f64 + 0.5) / n as f64 * (t1 - t0);
+                section(tris, &axis, &center, t, &ray)
+            })
+            .collect();
+        let radii: Vec<f64> = sections.iter().map(|s| s.radius).collect();
+        let flags: Vec<bool> = sections.iter().map(|s| s.pierced).collect();
+        let min_len = ((params.min_region_fraction * n as f64).ceil() as usize).max(1);
+        // Where the axis enters or leaves a hole is the cut (a ring lying
+        // flat: near arc, middle, far arc; the radius profile means nothing
+        // across a hole); without a hole, the paper's radius profile cuts.
+        let runs = match hole_runs(&flags, min_len) {
+            parts if parts.len() > 1 => parts,
+            _ => segment_profile(&radii, params),
+        };
+        Split {
+            axis,
+            t0,
+            t1,
+            n,
+            runs,
+        }
+    }
+
+    /// The run's bounds along the axis.
+    fn bounds(&self, run: &std::ops::Range<usize>) -> (f64, f64) {
+        let at = |k: usize| self.t0 + k as f64 / self.n as f64 * (self.t1 - self.t0);
+        (at(run.start), at(run.end))
+    }
+}
+
 /// The OCPs of an object surface given in the world frame, with free faces.
 ///
 /// `vertices` and `triangles` must describe a valid surface (see
@@ -567,55 +631,18 @@ pub fn object_ocps(
         return Vec::new();
     };
     let global = tighten(global, &whole, vertices, params);
-    // Split along the longest box axis; of axes equally long (within
-    // `LONGEST_TIE`), the first: the preferred one of a symmetric pair (a
-    // ring lying flat splits into its near arc, middle and far arc).
-    let longest = global.extents.max();
-    let long = (0..3)
-        .find(|&k| global.extents[k] >= (1.0 - LONGEST_TIE) * longest)
-        .unwrap_or(0);
-    let axis = global.rotation.matrix().column(long).into_owned();
-    let center = global.center.coords;
-    let (t0, t1) = {
-        let c = axis.dot(&center);
-        (
-            c - 0.5 * global.extents[long],
-            c + 0.5 * global.extents[long],
-        )
-    };
-    let n = params.slices.max(1);
-    let m = global.rotation.matrix();
-    let (u, v) = (m.column((long + 1) % 3), m.column((long + 2) % 3));
-    // The parity ray, off the box's axes and diagonals.
-    let ray = (u * 0.37f64.cos() + v * 0.37f64.sin()).normalize();
-    let sections: Vec<Section> = (0..n)
-        .map(|k| {
-            let t = t0 + (k as f64 + 0.5) / n as f64 * (t1 - t0);
-            section(&tris, &axis, &center, t, &ray)
-        })
-        .collect();
-    let radii: Vec<f64> = sections.iter().map(|s| s.radius).collect();
-    let flags: Vec<bool> = sections.iter().map(|s| s.pierced).collect();
-    let min_len = ((params.min_region_fraction * n as f64).ceil() as usize).max(1);
-    // Where the axis enters or leaves a hole is the cut (a ring lying flat:
-    // near arc, middle, far arc; the radius profile means nothing across a
-    // hole); without a hole, the paper's radius profile cuts.
-    let runs = match hole_runs(&flags, min_len) {
-        parts if parts.len() > 1 => parts,
-        _ => segment_profile(&radii, params),
-    };
-    let mut ocps = if runs.len() <= 1 {
+    let split = Split::of(&tris, &global, params);
+    let mut ocps = if split.runs.len() <= 1 {
         vec![global]
     } else {
         let mut out = Vec::new();
-        for run in &runs {
-            let a = t0 + run.start as f64 / n as f64 * (t1 - t0);
-            let b = t0 + run.end as f64 / n as f64 * (t1 - t0);
+        for run in &split.runs {
+            let (a, b) = split.bounds(run);
             let polygons: Vec<Vec<Vector3<f64>>> = tris
                 .iter()
                 .filter_map(|t| {
-                    let p = clip(t, &axis, a, true);
-                    let p = clip(&p, &axis, b, false);
+                    let p = clip(t, &split.axis, a, true);
+                    let p = clip(&p, &split.axis, b, false);
                     (p.len() >= 3).then_some(p)
                 })
                 .collect();

@@ -98,10 +98,8 @@ pub fn palm_targets(
             None => (e1, e2),
             Some(t) => {
                 rot = t * rot;
-                (
-                    across(ocp, &(rot * cols_axis(p1))),
-                    across(ocp, &(rot * cols_axis(p2))),
-                )
+                let axis = |k: usize| rot * Vector3::ith(k, 1.0);
+                (across(ocp, &axis(p1)), across(ocp, &axis(p2)))
             }
         };
         // Containment: GRCmax holds the face, GRCmin fits on it.
@@ -124,11 +122,6 @@ pub fn palm_targets(
         });
     }
     out
-}
-
-/// The palm frame's axis `k` (in the palm frame).
-fn cols_axis(k: usize) -> Vector3<f64> {
-    Vector3::ith(k, 1.0)
 }
 
 /// The OCP's full extent along the world unit direction `w`.
