@@ -17,6 +17,7 @@
 //!   surface does not constrain (a can's spin) stay zero;
 //! - point-to-point (Besl & McKay): the Kabsch rotation from the SVD of the
 //!   cross-covariance (nalgebra).
+//!
 //! Weights are Huber's (scale `huber`). The gate shrinks geometrically from
 //! `gate_start` to `gate_end`.
 //!

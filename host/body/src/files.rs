@@ -376,7 +376,7 @@ pub fn redact(message: &str) -> String {
         out.push_str(&rest[..start]);
         let after = &rest[start + 1..];
         let Some(end) = after.find(quote) else {
-            out.push_str("…");
+            out.push('…');
             rest = "";
             break;
         };

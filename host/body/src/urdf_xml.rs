@@ -620,7 +620,7 @@ fn read_joint(node: Node, d: &mut Diagnostics) -> Result<RawJoint> {
     let child = link_of("child", d)?;
     let origin = pose(node, &el, d)?;
     let axis = match first(node, "axis") {
-        Some(a) => vector::<3>(a, "xyz", &format!("{el}"), d)?.unwrap_or([1.0, 0.0, 0.0]),
+        Some(a) => vector::<3>(a, "xyz", &el.to_string(), d)?.unwrap_or([1.0, 0.0, 0.0]),
         None => [1.0, 0.0, 0.0],
     };
     let limit = match first(node, "limit") {
