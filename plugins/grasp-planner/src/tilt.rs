@@ -11,13 +11,13 @@
 //! placements leave none of them clear: a 25 mm flat box on a 1 m counter
 //! (from the top the fingers and the thumb meet the counter, a side face is
 //! lower than the fingers are wide), the same box under a shelf board (the
-//! forearm meets the board above), a ball lying on a table (its top cap is
-//! too small to hold, the fingers of a side approach meet the table). A person
-//! takes them with the hand coming at an angle: on the counter from the near
-//! side, almost level; on the shelf from the top, leaning to the side; the
-//! ball from the side, over its top. The tilted approaches are tried only
-//! after every axis-aligned one has failed on every whole-body stage, so a
-//! scene that plans without them plans exactly the same.
+//! forearm meets the board above), a thin ring lying on a low table (the
+//! fingers of every straight approach meet the table). A person takes them
+//! with the hand coming at an angle: on the counter from the near side,
+//! almost level; on the shelf from the top, leaning to the side; the ring
+//! from the top, leaning over its near side. The tilted approaches are tried
+//! only after every axis-aligned one has failed on every whole-body stage, so
+//! a scene that plans without them plans exactly the same.
 //!
 //! How: [`rotation`] is the rotation by `angle` about `n × n₂` (`n` the
 //! face's outward normal, `n₂` the neighbour's): it takes `n` to
