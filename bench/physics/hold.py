@@ -321,7 +321,27 @@ def contact_summary(m, d, obj):
     return sorted(links), deepest
 
 
-def run_sim(xml, hand, mass, c_ref, r_ref, pose_override=None):
+def planned_gaps(m, d, obj, planned_links):
+    """Distance (mm) from each planned contact link to the object at the start: checks
+    that the converted hand is where the planner put it."""
+    og = [g for g in range(m.ngeom) if m.geom_bodyid[g] == obj]
+    out = {}
+    for link in planned_links:
+        try:
+            b = m.body(link).id
+        except KeyError:
+            continue
+        best = math.inf
+        for g in range(m.ngeom):
+            if m.geom_bodyid[g] != b:
+                continue
+            for g2 in og:
+                best = min(best, mujoco.mj_geomDistance(m, d, g, g2, 0.05, None))
+        out[link] = round(1e3 * best, 2)
+    return out
+
+
+def run_sim(xml, hand, mass, c_ref, r_ref, palm_rot=np.eye(3), planned_links=()):
     m = mujoco.MjModel.from_xml_string(xml)
     d = mujoco.MjData(m)
     for name, q in hand.q0.items():
@@ -331,16 +351,26 @@ def run_sim(xml, hand, mass, c_ref, r_ref, pose_override=None):
     obj = m.body("object").id
     mujoco.mj_forward(m, d)
     start_links, start_depth = contact_summary(m, d, obj)
-    res = {"start_contacts": start_links, "start_penetration_mm": round(-1e3 * start_depth, 2)}
+    res = {"planned_contact_gap_mm": planned_gaps(m, d, obj, planned_links),
+           "start_contacts": start_links, "start_penetration_mm": round(-1e3 * start_depth, 2)}
     worst_s, worst_t = 0.0, 0.0
-    for _ in range(int(round(SETTLE_S / TIMESTEP))):
+    first_touch, most = None, (0, [])
+    for k in range(int(round(SETTLE_S / TIMESTEP))):
         mujoco.mj_step(m, d)
         s, t = deviation(d, obj, c_ref, r_ref)
         worst_s, worst_t = max(worst_s, s), max(worst_t, t)
+        links, _ = contact_summary(m, d, obj)
+        if links and first_touch is None:
+            first_touch = (k + 1) * TIMESTEP
+        if len(links) > most[0]:
+            most = (len(links), links)
     links, depth = contact_summary(m, d, obj)
     s, t = deviation(d, obj, c_ref, r_ref)
+    shift_palm = palm_rot.T @ (d.xipos[obj] - c_ref)
     res["settle"] = {"shift_mm": round(1e3 * s, 2), "turn_deg": round(math.degrees(t), 2),
                      "max_shift_mm": round(1e3 * worst_s, 2), "max_turn_deg": round(math.degrees(worst_t), 2),
+                     "shift_in_palm_frame_mm": [round(1e3 * float(x), 1) for x in shift_palm],
+                     "first_touch_s": first_touch, "most_contacts": most[1],
                      "contacts": links, "penetration_mm": round(-1e3 * depth, 2)}
     settled_ok = worst_s <= MAX_SHIFT and worst_t <= MAX_TURN
     spec = mujoco.mjtState.mjSTATE_INTEGRATION
@@ -391,6 +421,15 @@ def judge(case, hand, noise=False):
     pos = np.array(o["pose"]["position"], dtype=float)
     quat = quat_xyzw_to_wxyz(o["pose"]["quaternion"])
     r_plan = quat_to_mat(quat)
+    planner_com = reply.get("object", {}).get("center_of_mass")
+    com_source = "case" if o.get("center_of_mass") is not None else "mesh"
+    if not closed and o.get("center_of_mass") is None and planner_com is not None:
+        # The mesh closes no volume trimesh can measure (e.g. a handle touching the body
+        # along an edge): take the planner's centroid of the enclosed volume instead of the hull's.
+        c = r_plan.T @ (np.array(planner_com, dtype=float) - pos)
+        mesh = load_mesh(o["mesh"], float(o.get("scale") or 1.0))
+        com, inertia, _ = mass_properties(mesh, mass, c)
+        com_source = "planner"
     c_plan = pos + r_plan @ com
     noise_info = None
     if noise:
@@ -400,13 +439,14 @@ def judge(case, hand, noise=False):
     xml = build_xml(hand, np.array(pp["position"], dtype=float), quat_xyzw_to_wxyz(pp["quaternion"]),
                     info["parts"], pos, quat, mass, com, inertia, mu)
     t = time.perf_counter()
-    res = run_sim(xml, hand, mass, c_plan, r_plan)
+    palm_rot = quat_to_mat(quat_xyzw_to_wxyz(pp["quaternion"]))
+    res = run_sim(xml, hand, mass, c_plan, r_plan, palm_rot, [c["link"] for c in reply.get("contacts", [])])
     res["sim_s"] = round(time.perf_counter() - t, 3)
     res["object"] = {"decomposition": info["how"], "parts": len(info["parts"]), "closed": closed,
                      "mass": mass, "mu": mu}
     if noise_info:
         res["noise"] = noise_info
-    planner_com = reply.get("object", {}).get("center_of_mass")
+    res["object"]["com_source"] = com_source
     if planner_com is not None:
         res["com_vs_planner_mm"] = round(1e3 * float(np.linalg.norm(np.array(planner_com) - c_plan)), 2)
     return res
@@ -591,8 +631,9 @@ def main():
             bad = [k for k, p in n["pull"].items() if not p["holds"]]
             extra = f" noise:{'HOLD' if rec['noise']['holds'] else 'fail'}" if a.noise else ""
             log(f"  {c['case']:<40} {rec['grasp_type']:<18} {'HOLD' if n['holds'] else 'fail'}{extra}"
-                f"  settle {n['settle']['shift_mm']:.1f} mm {n['settle']['turn_deg']:.1f} deg,"
-                f" contacts {len(n['settle']['contacts'])}, fails {','.join(bad) or '-'}")
+                f"  settle {n['settle']['shift_mm']:.1f} mm {n['settle']['turn_deg']:.1f} deg"
+                f" (palm xyz {n['settle']['shift_in_palm_frame_mm']}),"
+                f" contacts {len(n['settle']['contacts'])}/{len(c['reply']['contacts'])}, fails {','.join(bad) or '-'}")
     summ = summary(records, a.noise)
     if records:
         log("hold rate:")
