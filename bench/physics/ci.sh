@@ -13,7 +13,8 @@ if ! python3 -c "import mujoco, trimesh, coacd, numpy" 2>/dev/null; then
     echo "bench/physics/ci.sh: python packages missing (pip install -r bench/physics/requirements.txt)" >&2
     exit 1
 fi
-cargo run -q -p tsukami-grasp-planner --example physics_cases -- \
+# PHYSICS_CI_PROFILE=release to reuse a release build instead (local runs).
+cargo run -q --profile "${PHYSICS_CI_PROFILE:-dev}" -p tsukami-grasp-planner --example physics_cases -- \
     --seed 1 --quick --limit "${PHYSICS_CI_CASES:-9}" --out "$out/humanoid.jsonl"
 python3 bench/physics/hold.py --cases "$out/humanoid.jsonl" --noise \
     --json "$out/results.json" --md "$out/results.md"

@@ -570,6 +570,38 @@ def summary(records, noise):
             if not p["holds"]:
                 fails[dn] += 1
     out["failing_direction_counts"] = dict(fails)
+    out["failure_modes"] = failure_modes(records)
+    return out
+
+
+def failure_modes(records):
+    """Per grasp type: how the nominal failures fail. `lost_in_squeeze`: the object left
+    the 2 cm / 15 deg bound while the servos squeezed with no load (pushed out of the
+    hand); `lost_under_load`: it stayed during the squeeze but some pull moved it out.
+    `median_out_of_palm_mm`: the median settle shift along the palm normal (+ = away
+    from the palm); `contacts_kept`: hand links touching after the squeeze / planned."""
+    by = defaultdict(list)
+    for r in records:
+        by[r["grasp_type"]].append(r)
+    out = {}
+    for gt, rs in sorted(by.items()):
+        fails = [r for r in rs if not r["nominal"]["holds"]]
+        squeeze = [r for r in fails if r["nominal"]["settle"]["max_shift_mm"] > 1e3 * MAX_SHIFT
+                   or r["nominal"]["settle"]["max_turn_deg"] > math.degrees(MAX_TURN)]
+        load = [r for r in fails if r not in squeeze]
+        dirs = defaultdict(int)
+        for r in load:
+            for dn, p in r["nominal"]["pull"].items():
+                if not p["holds"]:
+                    dirs[dn] += 1
+        kept = [len(r["nominal"]["settle"]["contacts"]) for r in rs]
+        out_palm = sorted(r["nominal"]["settle"]["shift_in_palm_frame_mm"][2] for r in rs)
+        turns = sorted(r["nominal"]["settle"]["turn_deg"] for r in rs)
+        out[gt] = {"cases": len(rs), "holds": len(rs) - len(fails), "lost_in_squeeze": len(squeeze),
+                   "lost_under_load": len(load), "load_failure_directions": dict(dirs),
+                   "mean_contacts_kept": round(float(np.mean(kept)), 2),
+                   "median_out_of_palm_mm": out_palm[len(out_palm) // 2],
+                   "median_settle_turn_deg": turns[len(turns) // 2]}
     return out
 
 
@@ -584,6 +616,13 @@ def markdown(summ, noise, controls):
             if noise:
                 row += f" {v['holds_noise']} | {pct(v['holds_noise'], v['cases'])} |"
             lines.append(row)
+    lines += ["\n**Failure modes (nominal)**\n",
+              "| grasp type | cases | holds | lost in squeeze | lost under load | load-failure directions | contacts kept | median out-of-palm shift (mm) |",
+              "|---|---:|---:|---:|---:|---|---:|---:|"]
+    for gt, v in summ["failure_modes"].items():
+        dirs = ", ".join(f"{k} {n}" for k, n in sorted(v["load_failure_directions"].items())) or "-"
+        lines.append(f"| {gt} | {v['cases']} | {v['holds']} | {v['lost_in_squeeze']} | {v['lost_under_load']} | "
+                     f"{dirs} | {v['mean_contacts_kept']} | {v['median_out_of_palm_mm']} |")
     lines += ["\n**Controls**\n", "| control | must | outcome |", "|---|---|---|"]
     for c in controls:
         lines.append(f"| {c['control']} | {'hold' if c['must_hold'] else 'fail'} | "
@@ -601,7 +640,24 @@ def main():
     ap.add_argument("--md", help="write the Markdown tables here")
     ap.add_argument("--controls-only", action="store_true")
     ap.add_argument("--quiet", action="store_true", help="no line per case")
+    ap.add_argument("--fallback-squeeze", type=float, default=None,
+                    help="diagnosis only, not the protocol: rad beyond planned for the fallback")
+    ap.add_argument("--summarize", metavar="RESULTS.json",
+                    help="no simulation: recompute the summary and --md from a results file")
     a = ap.parse_args()
+    if a.summarize:
+        with open(a.summarize) as f:
+            res = json.load(f)
+        noise = any("noise" in r for r in res["cases"])
+        summ = summary(res["cases"], noise)
+        print(json.dumps(summ, indent=1))
+        if a.md:
+            with open(a.md, "w") as f:
+                f.write(markdown(summ, noise, res["controls"]))
+        return 0 if all(c["ok"] for c in res["controls"]) else 1
+    if a.fallback_squeeze is not None:
+        global FALLBACK_SQUEEZE
+        FALLBACK_SQUEEZE = a.fallback_squeeze
     log = lambda s: print(s, flush=True)  # noqa: E731
     cases = []
     for fn in a.cases:
@@ -642,6 +698,9 @@ def main():
                 extra = f", noise {v['holds_noise']}/{v['cases']} ({pct(v['holds_noise'], v['cases'])})" if a.noise else ""
                 log(f"  {title:<10} {k:<22} {v['holds']}/{v['cases']} ({pct(v['holds'], v['cases'])}){extra}")
         log(f"  failing directions (nominal): {summ['failing_direction_counts']}")
+        log("failure modes (nominal):")
+        for gt, v in summ["failure_modes"].items():
+            log(f"  {gt:<18} {v}")
     log(f"controls {'ok' if controls_ok else 'MISBEHAVE'}; {time.perf_counter() - t0:.1f} s")
     constants = {k: v for k, v in globals().items() if k.isupper() and isinstance(v, (int, float, tuple, dict))}
     if a.json:
