@@ -40,6 +40,7 @@ MAX_SHIFT = 0.02              # m, of the centre of mass from its planned place
 MAX_TURN = math.radians(15)   # rad, of the object from its planned orientation
 SERVO_SPAN = 0.2              # rad: kp = effort / SERVO_SPAN without a squeeze entry
 FALLBACK_SQUEEZE = 0.1        # rad beyond the planned position on the flex joints
+RAMP_S = 0.0                  # s: targets stepped at t = 0 (--ramp S: a linear ramp, diagnosis only)
 DAMPRATIO = 1.0               # servo damping: critical (MuJoCo's dampratio)
 ARMATURE = 1e-4               # kg m^2 (or kg) on every hand joint: the motor's reflected inertia
 SOLREF = (0.01, 1.0)          # the "rubber pad": 10 ms time constant, critically damped
@@ -346,8 +347,12 @@ def run_sim(xml, hand, mass, c_ref, r_ref, palm_rot=np.eye(3), planned_links=())
     d = mujoco.MjData(m)
     for name, q in hand.q0.items():
         d.qpos[m.jnt_qposadr[m.joint(name).id]] = q
-    for name, t in hand.target.items():
-        d.ctrl[m.actuator(f"a_{name}").id] = t
+    act = [(m.actuator(f"a_{name}").id, hand.q0[name], t) for name, t in hand.target.items()]
+    def ramp(time_s):
+        a = 1.0 if RAMP_S <= 0 else min(1.0, time_s / RAMP_S)
+        for i, q, t in act:
+            d.ctrl[i] = q + a * (t - q)
+    ramp(0.0)
     obj = m.body("object").id
     mujoco.mj_forward(m, d)
     start_links, start_depth = contact_summary(m, d, obj)
@@ -356,6 +361,7 @@ def run_sim(xml, hand, mass, c_ref, r_ref, palm_rot=np.eye(3), planned_links=())
     worst_s, worst_t = 0.0, 0.0
     first_touch, most = None, (0, [])
     for k in range(int(round(SETTLE_S / TIMESTEP))):
+        ramp(k * TIMESTEP)
         mujoco.mj_step(m, d)
         s, t = deviation(d, obj, c_ref, r_ref)
         worst_s, worst_t = max(worst_s, s), max(worst_t, t)
@@ -644,7 +650,11 @@ def main():
                     help="diagnosis only, not the protocol: rad beyond planned for the fallback")
     ap.add_argument("--summarize", metavar="RESULTS.json",
                     help="no simulation: recompute the summary and --md from a results file")
+    ap.add_argument("--ramp", type=float, default=None, help="diagnosis only: RAMP_S in s (0: step)")
     a = ap.parse_args()
+    if a.ramp is not None:
+        global RAMP_S
+        RAMP_S = a.ramp
     if a.summarize:
         with open(a.summarize) as f:
             res = json.load(f)
