@@ -179,6 +179,10 @@ impl RobotModel {
     ) -> Matrix6xX<f64> {
         let mut cols = vec![Vector6::zeros(); selection.len()];
         self.jacobian_columns(fk, link, &(fk.poses[link] * point), selection, &mut cols);
+        if cols.is_empty() {
+            // nalgebra's `from_columns` refuses an empty list.
+            return Matrix6xX::zeros(0);
+        }
         Matrix6xX::from_columns(&cols)
     }
 

@@ -58,6 +58,7 @@ use nalgebra::{Matrix6, SymmetricEigen, Vector3};
 
 use crate::grasp::Grasp;
 use crate::grasp_matrix::{contact_block, Wrench};
+use crate::joint_torques::JointTorques;
 
 /// Smallest eigenvalue of `G Gᵀ` relative to its largest for `G` to count as rank 6.
 pub const RANK_TOLERANCE: f64 = 1e-12;
@@ -106,6 +107,9 @@ pub struct ExactClosure {
     pub squeeze_margin: f64,
     /// Numerical rank of `G` (0–6).
     pub grasp_rank: usize,
+    /// The internal forces (world frame, N) of the squeeze `τ*`: they balance
+    /// each other (`G f = 0`).
+    pub forces: Vec<Vector3<f64>>,
 }
 
 /// Exact weight test.
@@ -164,6 +168,7 @@ fn solve(
     grasp: &Grasp,
     cone: ConeModel,
     extra: Extra<'_>,
+    joints: Option<&JointTorques>,
 ) -> Result<(Vec<f64>, f64, Wrench), ExactError> {
     let n = grasp.len();
     let nv = 3 * n + 1;
@@ -211,6 +216,29 @@ fn solve(
     }
     cones.push(SupportedConeT::NonnegativeConeT(n));
     row += n;
+
+    // Joint torques: τ_max,j ∓ Σ_i (J_iᵀ U_i f_i)_j ≥ 0 (both signs).
+    if let Some(t) = joints {
+        if t.contacts() != n {
+            return Err(ExactError::Setup(format!(
+                "joint torque limits for {} contacts, the grasp has {n}",
+                t.contacts()
+            )));
+        }
+        let m = t.joints();
+        for (i, c) in grasp.contacts().iter().enumerate() {
+            let rows = t.rows(i, &c.frame());
+            for j in 0..m {
+                for k in 0..3 {
+                    push(row + j, 3 * i + k, rows[(k, j)], &mut ri, &mut ci, &mut vals);
+                    push(row + m + j, 3 * i + k, -rows[(k, j)], &mut ri, &mut ci, &mut vals);
+                }
+            }
+        }
+        b.extend(t.efforts().iter().chain(t.efforts()));
+        cones.push(SupportedConeT::NonnegativeConeT(2 * m));
+        row += 2 * m;
+    }
 
     // Friction: slack = b − A x inside the cone; τ enters with +1 in A.
     let squeeze = matches!(extra, Extra::Squeeze);
@@ -306,8 +334,19 @@ fn run_clarabel(
 
 /// Exact force closure with cone model `cone` (see the module docs).
 pub fn exact_force_closure(grasp: &Grasp, cone: ConeModel) -> Result<ExactClosure, ExactError> {
+    exact_force_closure_with(grasp, cone, None)
+}
+
+/// [`exact_force_closure`] with the internal forces also limited by the
+/// joints' torques (`joints`; [`crate::joint_torques`]): the largest squeeze
+/// the hand can make, and its forces.
+pub fn exact_force_closure_with(
+    grasp: &Grasp,
+    cone: ConeModel,
+    joints: Option<&JointTorques>,
+) -> Result<ExactClosure, ExactError> {
     let grasp_rank = grasp_rank(grasp);
-    let (_, tau, _) = solve(grasp, cone, Extra::Squeeze)?;
+    let (x, tau, _) = solve(grasp, cone, Extra::Squeeze, joints)?;
     let f_min = grasp
         .force_limits()
         .iter()
@@ -318,7 +357,18 @@ pub fn exact_force_closure(grasp: &Grasp, cone: ConeModel) -> Result<ExactClosur
         force_closure,
         squeeze_margin: tau,
         grasp_rank,
+        forces: world_forces(grasp, &x),
     })
+}
+
+/// The world-frame contact forces of a solution `x` (local components).
+fn world_forces(grasp: &Grasp, x: &[f64]) -> Vec<Vector3<f64>> {
+    grasp
+        .contacts()
+        .iter()
+        .enumerate()
+        .map(|(i, c)| c.frame() * Vector3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]))
+        .collect()
 }
 
 /// The largest multiple of `external` (e.g. the weight wrench) the grasp can
@@ -328,16 +378,22 @@ pub fn exact_weight_scale(
     cone: ConeModel,
     external: &Wrench,
 ) -> Result<ExactWeight, ExactError> {
+    exact_weight_scale_with(grasp, cone, external, None)
+}
+
+/// [`exact_weight_scale`] with the contact forces also limited by the joints'
+/// torques (`joints`; [`crate::joint_torques`]).
+pub fn exact_weight_scale_with(
+    grasp: &Grasp,
+    cone: ConeModel,
+    external: &Wrench,
+    joints: Option<&JointTorques>,
+) -> Result<ExactWeight, ExactError> {
     if !external.iter().all(|x| x.is_finite()) {
         return Err(ExactError::BadWrench);
     }
-    let (x, s, certificate) = solve(grasp, cone, Extra::Scale(external))?;
-    let forces = grasp
-        .contacts()
-        .iter()
-        .enumerate()
-        .map(|(i, c)| c.frame() * Vector3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]))
-        .collect();
+    let (x, s, certificate) = solve(grasp, cone, Extra::Scale(external), joints)?;
+    let forces = world_forces(grasp, &x);
     Ok(ExactWeight {
         weight_scale: s.max(0.0),
         forces,

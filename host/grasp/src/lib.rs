@@ -12,10 +12,13 @@
 //! | [`ellipsoid`] | the paper's eqs. (9)–(10), margin `n − f` | ~0.3 µs, no allocation |
 //! | [`exact`] | second-order cone programs (clarabel): exact closure, weight scale, forces | ~0.2 ms |
 //! | [`ferrari_canny`] | ε of the L1 and L∞ wrench spaces, 6-D hulls ([`hull`]: vendored Qhull) | ε_L1 ~3 ms, ε_L∞ seconds |
+//! | [`hold`] | closure + a disturbance set (±x/±y/±z weight, torques) with joint torque limits and a friction reserve; the squeeze | ~0.2 ms a disturbance |
 //!
 //! Supporting modules: [`contact`] (contacts and contact frames `U_i`),
 //! [`grasp_matrix`] (eq. (6), `G` with torque scale `γ`), [`finger_force`]
-//! (per-contact force limits from a finger Jacobian and joint efforts) and
+//! (per-contact force limits from a finger Jacobian and joint efforts),
+//! [`joint_torques`] (`τ = Σ Jᵢᵀ fᵢ` within the joints' efforts, as rows of
+//! the exact programs) and
 //! [`hull`] (6-D convex hulls). Pure functions only: the JSON contract of the
 //! `tsukami fc` command lives in the CLI (`host/app/src/cli/fc_problem.rs`).
 //!
@@ -51,4 +54,6 @@ pub mod ferrari_canny;
 pub mod finger_force;
 pub mod grasp;
 pub mod grasp_matrix;
+pub mod hold;
 pub mod hull;
+pub mod joint_torques;

@@ -417,6 +417,67 @@ pub struct PlanOptions {
     /// searched per whole-body stage, best first (default 8).
     #[serde(default = "default_max_candidates")]
     pub max_candidates: u32,
+    /// What a grasp must resist to be returned (`docs/force-closure.md`,
+    /// "Holding"): by default force closure and the weight along ±x, ±y, ±z
+    /// plus centre-of-mass torques, with the joints' torques.
+    #[serde(default)]
+    pub hold: HoldRequest,
+}
+
+/// Which disturbances a returned grasp must resist.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum DisturbanceSet {
+    /// Exact force closure, and the weight `m g` pulling along −z, +z, ±x,
+    /// ±y at the centre of mass, and the torques `m g · com_error` about the
+    /// same six axes, each balanced by forces the joints can make.
+    #[default]
+    Standard,
+    /// The weight along −z only, without requiring force closure (the paper's
+    /// test; a grasp may then rest the object on the fingers).
+    Gravity,
+}
+
+/// `PlanOptions::hold`: the physical acceptance test of a grasp.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HoldRequest {
+    /// The disturbance set (default `standard`).
+    #[serde(default)]
+    pub disturbances: DisturbanceSet,
+    /// Centre-of-mass error (m) whose torque `m g e` the grasp must resist
+    /// (default 0.02; 0 to 0.2).
+    #[serde(default = "default_com_error")]
+    pub com_error: f64,
+    /// Share of μ kept in reserve: forces stay inside the cone of
+    /// `(1 − friction_reserve) μ` (default 0.2; 0 to 0.9).
+    #[serde(default = "default_friction_reserve")]
+    pub friction_reserve: f64,
+    /// Share of each finger joint's effort the squeeze may use; the rest is
+    /// left for disturbances (default 0.5; above 0, at most 1).
+    #[serde(default = "default_squeeze_share")]
+    pub squeeze_share: f64,
+}
+
+fn default_com_error() -> f64 {
+    0.02
+}
+fn default_friction_reserve() -> f64 {
+    0.2
+}
+fn default_squeeze_share() -> f64 {
+    0.5
+}
+
+impl Default for HoldRequest {
+    fn default() -> Self {
+        Self {
+            disturbances: DisturbanceSet::default(),
+            com_error: default_com_error(),
+            friction_reserve: default_friction_reserve(),
+            squeeze_share: default_squeeze_share(),
+        }
+    }
 }
 
 fn default_max_samples() -> u32 {
@@ -437,6 +498,7 @@ impl Default for PlanOptions {
             delta_f: None,
             grasp_types: None,
             max_candidates: default_max_candidates(),
+            hold: HoldRequest::default(),
         }
     }
 }
@@ -539,6 +601,38 @@ pub struct ForceClosureReply {
     /// (`tsukami_scenes::verify`); 0 in replies of planners that predate it.
     #[serde(default)]
     pub force_limit: f64,
+    /// Exact force closure (rank 6 and an internal squeeze strictly inside
+    /// every cone).
+    #[serde(default)]
+    pub force_closure: bool,
+    /// The hold margin: the smallest multiple of any disturbance of the
+    /// request's set (`PlanOptions::hold`) that forces inside the reduced
+    /// friction cones, within the joints' torques, can balance. ≥ 1 for
+    /// every returned grasp; 2 means it resists twice the worst disturbance.
+    #[serde(default)]
+    pub hold_margin: f64,
+    /// The disturbance set the grasp was checked against.
+    #[serde(default)]
+    pub disturbances: DisturbanceSet,
+}
+
+/// One joint's squeeze: what a hand controller applies after contact so the
+/// fingers press with the planned forces (`docs/force-closure.md`, "The
+/// squeeze").
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct JointSqueeze {
+    /// Joint name (an independent hand joint; mimic joints follow theirs).
+    pub joint: String,
+    /// Position at contact (rad or m): the grasp posture.
+    pub position: f64,
+    /// Torque (N·m, or N for a prismatic joint) a torque-controlled hand applies.
+    pub torque: f64,
+    /// Servo stiffness (N·m/rad) the target assumes: the joint's effort over
+    /// the hand's `servo_saturation`.
+    pub stiffness: f64,
+    /// Target of a position-controlled hand: `position + torque / stiffness`,
+    /// clamped to the joint's limits; the trajectory's `close` phase ends here.
+    pub target: f64,
 }
 
 /// Time spent per phase, milliseconds.
@@ -595,6 +689,10 @@ pub struct PlanReply {
     pub characteristic_length: f64,
     /// Force-closure verdicts.
     pub force_closure: ForceClosureReply,
+    /// The squeeze beyond contact, per independent hand joint (empty in
+    /// replies of planners that predate it).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub squeeze: Vec<JointSqueeze>,
     /// Random samples drawn by Algorithm 1 over all candidates.
     pub samples: u32,
     /// Time per phase.
@@ -687,7 +785,17 @@ mod tests {
                 margin: 0.3,
                 exact_resists_weight: true,
                 force_limit: 5.0,
+                force_closure: true,
+                hold_margin: 1.5,
+                disturbances: DisturbanceSet::Standard,
             },
+            squeeze: vec![JointSqueeze {
+                joint: "r_index_j2".into(),
+                position: 0.5,
+                torque: 0.4,
+                stiffness: 15.0,
+                target: 0.5 + 0.4 / 15.0,
+            }],
             samples: 3,
             timing_ms: PhaseTiming::default(),
             candidates_tried: vec![],

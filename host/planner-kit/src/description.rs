@@ -75,9 +75,15 @@ pub struct HandSpec {
     /// Links besides the contacts allowed to touch the object (default none).
     #[serde(default)]
     pub touch_allowed: Vec<String>,
-    /// Largest normal force credited to one finger, N (default 100).
+    /// Largest normal force credited to one finger, N (default 100): an
+    /// upper bound only; the joints' torques limit the forces first.
     #[serde(default = "default_finger_force")]
     pub max_finger_force: f64,
+    /// Position error (rad, or m) at which a finger joint's servo reaches
+    /// its full effort: the stiffness a squeeze target assumes is
+    /// `effort / servo_saturation` (default 0.2).
+    #[serde(default = "default_servo_saturation")]
+    pub servo_saturation: f64,
 }
 
 fn default_contact_distance() -> f64 {
@@ -85,6 +91,9 @@ fn default_contact_distance() -> f64 {
 }
 fn default_finger_force() -> f64 {
     100.0
+}
+fn default_servo_saturation() -> f64 {
+    0.2
 }
 
 /// A robot description file.
@@ -145,6 +154,9 @@ impl Description {
             }
             if !(h.max_finger_force.is_finite() && h.max_finger_force > 0.0) {
                 return Err(bad(key("max_finger_force"), "must be finite and > 0"));
+            }
+            if !(h.servo_saturation > 0.0 && h.servo_saturation <= 3.0) {
+                return Err(bad(key("servo_saturation"), "must be in (0, 3]"));
             }
         }
         Ok(())

@@ -636,6 +636,7 @@ fn fingertip(
         posture: posture_map(kin, &p.q),
         contacts,
         touch_allowed: Vec::new(),
+        palm_contact: false,
         grc_max: grc(&centre, [open_x, 0.3, 0.3]),
         grc_min: grc(&centre, [min_x, width, 0.01]),
         grc_des: grc(&centre, [d, width * opts.row_factor, d]),
@@ -779,6 +780,7 @@ fn envelope(
             .iter()
             .map(|&l| kin.model.links[l].name.clone())
             .collect(),
+        palm_contact: false,
         grc_max: grc(&centre, [open_x.max(d), 0.3, 0.3]),
         grc_min: grc(&centre, [min_x, width, 0.01]),
         grc_des: grc(&centre, [d, width * opts.row_factor, d]),

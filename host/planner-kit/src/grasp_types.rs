@@ -130,6 +130,11 @@ pub struct GraspType {
     /// grasp); default none.
     #[serde(default)]
     pub touch_allowed: Vec<String>,
+    /// The palm presses the object too (a power grasp): the nominal pose lays
+    /// the object on the palm, the palm is a contact of the force analysis,
+    /// and a grasp without it is refused (default false).
+    #[serde(default)]
+    pub palm_contact: bool,
     /// GRCmax: largest box that fits without touching the fingers.
     pub grc_max: GrcBox,
     /// GRCmin: smallest object the posture can hold.

@@ -72,8 +72,10 @@ pub struct Hand {
     pub contact_distance: f64,
     /// Links besides the contacts allowed to touch the object.
     pub touch_allowed: Vec<LinkId>,
-    /// Force cap per finger, N.
+    /// Force cap per finger, N (an upper bound; the joints' torques limit first).
     pub max_finger_force: f64,
+    /// Servo position error at full effort (rad or m), for squeeze targets.
+    pub servo_saturation: f64,
     /// The hand's grasp types.
     pub grasp_types: GraspTypeConfig,
 }
@@ -243,6 +245,7 @@ impl Hand {
             contact_distance: spec.contact_distance,
             touch_allowed,
             max_finger_force: spec.max_finger_force,
+            servo_saturation: spec.servo_saturation,
             grasp_types,
         })
     }

@@ -195,6 +195,7 @@ impl<P: GraspPlanner> Session<P> {
         if opts.delta_f.is_some_and(|d| !d.is_finite()) {
             return Err(KitError::invalid("delta_f", "must be finite"));
         }
+        crate::validate::hold_request(&opts.hold)?;
         if let Some(names) = &opts.grasp_types {
             let known = self.planner.grasp_types(world.robot, world.robot_data);
             if let Some((i, n)) = names.iter().enumerate().find(|(_, n)| !known.contains(n)) {
@@ -241,7 +242,7 @@ impl<P: GraspPlanner> Session<P> {
                 })
             }
             Ok(grasp) => {
-                let verdict = verify(&world, &grasp).map_err(KitError::Unverified)?;
+                let verdict = verify(&world, &grasp, &opts.hold).map_err(KitError::Unverified)?;
                 let (timing, tried, samples) = run.finish();
                 let report = RunReport {
                     timing,

@@ -3,7 +3,7 @@
 //! What: [`Limits`] — the workspace radius, the friction range, the mass range
 //! and the centre-of-mass margin — and the checks built on them: [`pose`]
 //! (finite, inside the workspace, a quaternion that normalises), [`friction`],
-//! [`mass`] and [`center_of_mass`].
+//! [`mass`], [`center_of_mass`] and [`hold_request`].
 //!
 //! Why: a position of 1e308 m, a centre of mass 10 m outside the object or a
 //! friction of 50 used to be accepted and broke every later plan (or put NaN in
@@ -206,4 +206,25 @@ mod tests {
         let e = center_of_mass(&[10.0, 0.0, 0.1], &lo, &hi, "com", &l).unwrap_err();
         assert!(e.to_string().contains("outside"), "{e}");
     }
+}
+
+/// A plan's hold request (`PlanOptions::hold`): every share and distance in
+/// its documented range.
+pub fn hold_request(h: &tsukami_msgs::planner::HoldRequest) -> Result<(), KitError> {
+    let ranged = |v: f64, field: &str, lo: f64, hi: f64, lo_open: bool| {
+        let above = if lo_open { v > lo } else { v >= lo };
+        match v.is_finite() && above && v <= hi {
+            true => Ok(()),
+            false => Err(KitError::invalid(
+                format!("hold.{field}"),
+                format!(
+                    "{v} is outside {}{lo}, {hi}]",
+                    if lo_open { "(" } else { "[" }
+                ),
+            )),
+        }
+    };
+    ranged(h.com_error, "com_error", 0.0, 0.2, false)?;
+    ranged(h.friction_reserve, "friction_reserve", 0.0, 0.9, false)?;
+    ranged(h.squeeze_share, "squeeze_share", 0.0, 1.0, true)
 }

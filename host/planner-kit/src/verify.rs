@@ -7,9 +7,12 @@
 //! (`tsukami_grasp::exact`, a second-order cone program) must find contact
 //! forces, each within its cone and the hand's single force bound (the weakest
 //! finger's `f_max`, stated in the reply as `force_limit`), that resist the object's
-//! weight. [`force_closure`] is the force-closure step alone, which planners
-//! call inside their loops (the ellipsoid margin of eq. (10) and the exact
-//! verdict).
+//! weight; and last the hold test of the request ([`crate::blocks::hold`]:
+//! exact force closure and every disturbance of the set balanced by forces
+//! the joints' torques can make, inside friction cones with a reserve), whose
+//! squeeze the reply carries. [`force_closure`] is the paper's step alone,
+//! which planners call inside their loops (the ellipsoid margin of eq. (10)
+//! and the exact weight verdict).
 //!
 //! Why: a planner may be new and wrong; the protocol promises that every grasp
 //! sent was verified. The checks here are the kit's, not the planner's.
@@ -30,6 +33,9 @@ use tsukami_body::kinematics::FkState;
 use tsukami_body::model::LinkId;
 
 use crate::blocks::grasp_check::check_in;
+use crate::blocks::hold::{hold, squeeze, HoldContact, HoldProblem};
+use crate::blocks::wrap::{style_check, StyleRule};
+use tsukami_msgs::planner::{DisturbanceSet, HoldRequest, JointSqueeze};
 use crate::grasp::{FingerContact, Grasp};
 use crate::object::Object;
 use crate::planner::{GraspPlanner, World};
@@ -38,7 +44,7 @@ use crate::planner::{GraspPlanner, World};
 pub const GRAVITY: Vector3<f64> = Vector3::new(0.0, 0.0, -9.81);
 
 /// The force-closure verdicts of a contact set for the object's weight.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Verdict {
     /// Ellipsoid margin `n − f(p1..pn)` of eq. (10).
     pub margin: f64,
@@ -49,6 +55,15 @@ pub struct Verdict {
     /// The one normal-force bound applied to every contact, N: the weakest
     /// finger's `f_max` (the paper's single maximum finger force).
     pub force_limit: f64,
+    /// Exact force closure.
+    pub force_closure: bool,
+    /// The hold margin (`tsukami_grasp::hold`): the smallest multiple of any
+    /// disturbance of the set the joints can balance.
+    pub hold_margin: f64,
+    /// The set checked.
+    pub disturbances: DisturbanceSet,
+    /// The squeeze per independent hand joint.
+    pub squeeze: Vec<JointSqueeze>,
 }
 
 /// The paper's single maximum finger force of a contact set: the weakest `f_max`.
@@ -79,6 +94,10 @@ pub fn force_closure(object: &Object, contacts: &[FingerContact], length: f64) -
         exact_resists_weight: exact.resists_weight(),
         characteristic_length: length,
         force_limit: limit,
+        force_closure: exact.closure.force_closure,
+        hold_margin: 0.0,
+        disturbances: DisturbanceSet::Gravity,
+        squeeze: Vec::new(),
     })
 }
 
@@ -144,18 +163,89 @@ pub fn geometric_checks<P: GraspPlanner>(
     check_in(world, &fk, &links, &grasp.contacts).map_err(|r| r.describe(model))
 }
 
-/// Verifies `grasp` on `world` (see the module docs); the verdict or why not.
-pub fn verify<P: GraspPlanner>(world: &World<'_, P>, grasp: &Grasp) -> Result<Verdict, String> {
+/// Verifies `grasp` on `world` against the hold request `req` (see the
+/// module docs); the verdict or why not.
+pub fn verify<P: GraspPlanner>(
+    world: &World<'_, P>,
+    grasp: &Grasp,
+    req: &HoldRequest,
+) -> Result<Verdict, String> {
     shape_checks(world, grasp)?;
     geometric_checks(world, grasp)?;
     let length = grasp
         .characteristic_length
         .filter(|l| l.is_finite() && *l > 0.0)
         .unwrap_or_else(|| world.object.characteristic_length());
-    let verdict = force_closure(world.object, &grasp.contacts, length)
+    let mut verdict = force_closure(world.object, &grasp.contacts, length)
         .ok_or("the contacts make no valid grasp matrix")?;
     if !verdict.exact_resists_weight || !verdict.margin.is_finite() {
         return Err("the exact friction-cone test finds no forces that resist the weight".into());
     }
+    hold_checks(world, grasp, length, req, &mut verdict)?;
     Ok(verdict)
+}
+
+/// The rule of the grasp's style ([`crate::blocks::wrap`]): the approach and
+/// palm requirement of its type in the hand's grasp-type file, or — for a
+/// type that file does not list (another planner's) — the palm normal and
+/// no palm requirement.
+fn style_rule<P: GraspPlanner>(world: &World<'_, P>, grasp: &Grasp, fk: &FkState) -> StyleRule {
+    let hand = world.hand();
+    let listed = hand
+        .grasp_types
+        .grasp_types
+        .iter()
+        .find(|g| g.name == grasp.grasp_type.name);
+    let approach = listed.map_or(Vector3::z(), |g| g.approach());
+    StyleRule {
+        style: grasp.grasp_type.style,
+        palm_contact: listed.is_some_and(|g| g.palm_contact),
+        palm: hand.palm,
+        approach: fk.pose(hand.palm).rotation * approach,
+    }
+}
+
+/// The hold test of the request and the squeeze, into `verdict`.
+fn hold_checks<P: GraspPlanner>(
+    world: &World<'_, P>,
+    grasp: &Grasp,
+    length: f64,
+    req: &HoldRequest,
+    verdict: &mut Verdict,
+) -> Result<(), String> {
+    let (model, hand, object) = (&world.robot.model, world.hand(), world.object);
+    let mut fk = FkState::new(model);
+    model.forward_kinematics(&grasp.q, &mut fk);
+    let problem = HoldProblem {
+        model,
+        fk: &fk,
+        joints: &hand.joints,
+        cap: hand.max_finger_force,
+        mass: object.mass,
+        mu: object.mu,
+        com: object.center_of_mass,
+        length,
+    };
+    let contacts: Vec<HoldContact> = grasp
+        .contacts
+        .iter()
+        .map(|c| (c.link, c.position, c.normal))
+        .collect();
+    style_check(&style_rule(world, grasp, &fk), &contacts)?;
+    let v = hold(&problem, &contacts, req).ok_or("the hold test could not be solved")?;
+    if req.disturbances == DisturbanceSet::Standard && !v.force_closure {
+        return Err("the contacts are not in force closure".into());
+    }
+    if !v.holds() {
+        return Err(format!(
+            "the joints' torques cannot hold the disturbances: the worst is resisted {:.2} times",
+            v.margin
+        ));
+    }
+    verdict.force_closure = v.force_closure;
+    verdict.hold_margin = v.margin;
+    verdict.disturbances = req.disturbances;
+    verdict.squeeze = squeeze(&problem, &contacts, &grasp.q, hand.servo_saturation, req)
+        .ok_or("no squeeze the joints can make balances the contacts")?;
+    Ok(())
 }

@@ -12,6 +12,14 @@
 //!   (`tsukami_grasp::finger_force`). The planner's `exact_resists_weight` flag and
 //!   its per-contact `f_max` are never read for the verdict; a missing bound is a
 //!   violation, never replaced by a default;
+//! - **force closure and the disturbances** (unless the reply says it was
+//!   checked against gravity alone): exact force closure of the reply's
+//!   contacts, and the weight pulling along ±x, ±y, ±z plus the torques of a
+//!   [`Tolerances::com_error`] centre-of-mass error, each balanced by forces
+//!   inside the friction cones that the hand's joints can make — the torques
+//!   `τ = Σ Jᵢᵀ fᵢ` within the URDF efforts, with this module's own Jacobians
+//!   (`tsukami_grasp::hold`; no friction reserve, no force cap: the physics
+//!   alone);
 //! - **contacts on the object**: each contact within [`Tolerances::surface`] of the
 //!   object's surface, its normal within [`Tolerances::normal_angle`] of the
 //!   surface's (inward) normal cone there, and its link within
@@ -59,6 +67,9 @@ use tsukami_body::kinematics::{FkState, JointSelection};
 use tsukami_body::model::{Geometry, LinkId};
 use tsukami_grasp::contact::Contact;
 use tsukami_grasp::exact::{exact_weight_scale, ConeModel};
+use tsukami_grasp::hold::{hold_test, Disturbances, HoldOptions};
+use tsukami_grasp::joint_torques::JointTorques;
+use tsukami_msgs::planner::DisturbanceSet;
 use tsukami_grasp::finger_force::max_finger_force;
 use tsukami_grasp::grasp::Grasp;
 use tsukami_msgs::planner::{ContactReply, PlanReply};
@@ -99,6 +110,8 @@ pub struct Tolerances {
     pub relative: f64,
     /// Largest centre-of-mass disagreement (m). 1 mm.
     pub center_of_mass: f64,
+    /// Centre-of-mass error (m) whose torque the grasp must resist. 2 cm.
+    pub com_error: f64,
 }
 
 impl Default for Tolerances {
@@ -113,6 +126,7 @@ impl Default for Tolerances {
             joint: 1e-9,
             relative: 1e-6,
             center_of_mass: 1e-3,
+            com_error: 0.02,
         }
     }
 }
@@ -124,6 +138,15 @@ pub enum Violation {
     NotHeld {
         /// Largest multiple of the weight the contacts can balance (< 1).
         weight_scale: f64,
+    },
+    /// The contacts are not in exact force closure.
+    NotForceClosure,
+    /// A disturbance the joints' torques cannot balance.
+    NotHeldUnder {
+        /// The disturbance (`"force +x"`, `"torque -z"`, …).
+        disturbance: String,
+        /// Largest multiple of it the contacts balance (< 1).
+        scale: f64,
     },
     /// The contacts do not make a grasp the exact test accepts (fewer than two,
     /// a zero normal, a bad μ or force limit).
@@ -218,6 +241,11 @@ impl fmt::Display for Violation {
                 "exact test: the contacts hold only {weight_scale:.3} x the weight"
             ),
             BadGrasp(m) => write!(f, "contacts are not a valid grasp: {m}"),
+            NotForceClosure => write!(f, "the contacts are not in exact force closure"),
+            NotHeldUnder { disturbance, scale } => write!(
+                f,
+                "the joints' torques balance only {scale:.3} x the disturbance {disturbance}"
+            ),
             ForceLimit {
                 stated,
                 capability,
@@ -320,6 +348,7 @@ pub fn verify(world: &World, reply: &PlanReply, tol: &Tolerances) -> Verdict {
             weakest = weakest_finger(world, reply, &fk, &mut v.violations);
             v.finger_capability = weakest.as_ref().map(|w| w.0);
             check_penetration(world, &fk, tol, &mut v);
+            check_hold(world, reply, &fk, tol, &mut v.violations);
         }
         None => v.violations.push(Violation::BadJoints(
             "posture checks skipped (collision, contacts' links, palm, finger forces)".into(),
@@ -554,6 +583,9 @@ fn weakest_finger(
             .into_iter()
             .filter(|j| r.hand_links.contains(&model.joints[*j].child))
             .collect();
+        if joints.is_empty() {
+            continue; // the palm: the arm carries it, no finger joint limits it
+        }
         let Ok(sel) = JointSelection::new(model, &joints) else {
             out.push(Violation::BadGrasp(format!(
                 "finger of {}: no joints",
@@ -597,6 +629,71 @@ fn check_force_limit(
             capability,
             link,
         });
+    }
+}
+
+/// Closure and the disturbance set with the hand's own torque limits (module
+/// docs); skipped, as the reply says, for a grasp checked on gravity alone.
+fn check_hold(
+    world: &World,
+    reply: &PlanReply,
+    fk: &FkState,
+    tol: &Tolerances,
+    out: &mut Vec<Violation>,
+) {
+    if reply.force_closure.disturbances == DisturbanceSet::Gravity {
+        return;
+    }
+    let (o, model) = (&world.object, &world.robot.model);
+    let hand: Vec<_> = (0..model.joints.len())
+        .filter(|&j| {
+            model.joints[j].is_independent()
+                && world.robot.hand_links.contains(&model.joints[j].child)
+        })
+        .collect();
+    let Ok(sel) = JointSelection::new(model, &hand) else {
+        return out.push(Violation::BadGrasp("the hand has no joints".into()));
+    };
+    let mut contacts = Vec::new();
+    let mut jacobians = Vec::new();
+    for c in &reply.contacts {
+        let (Some(link), Ok(contact)) = (
+            contact_link(world, c),
+            Contact::new(Point3::from(c.position), Vector3::from(c.normal)),
+        ) else {
+            return; // reported by check_contacts / recompute_exact
+        };
+        let local = fk.pose(link).inverse() * Point3::from(c.position);
+        let j6 = model.jacobian(fk, link, &local, &sel);
+        jacobians.push(Matrix3xX::from_fn(sel.len(), |row, k| j6[(row, k)]));
+        contacts.push(contact);
+    }
+    let efforts = sel.joints.iter().map(|&k| model.joints[k].limits.effort).collect();
+    let unlimited = vec![1e6; contacts.len()];
+    let length = o.mesh.bounding_diagonal();
+    let (Ok(grasp), Ok(torques)) = (
+        Grasp::with_force_limits(contacts, unlimited, o.mu, length, o.center_of_mass),
+        JointTorques::new(jacobians, efforts),
+    ) else {
+        return; // reported by recompute_exact
+    };
+    let g = -GRAVITY[2];
+    let set = Disturbances::standard(&grasp, o.mass, g, &o.center_of_mass, tol.com_error);
+    let physics = HoldOptions {
+        friction_reserve: 0.0,
+        require_closure: true,
+    };
+    match hold_test(&grasp, &torques, &set, &physics) {
+        Ok(v) if !v.force_closure => out.push(Violation::NotForceClosure),
+        Ok(v) => {
+            if let Some(i) = v.failed {
+                out.push(Violation::NotHeldUnder {
+                    disturbance: set.0[i].name.clone(),
+                    scale: v.scales[i],
+                });
+            }
+        }
+        Err(e) => out.push(Violation::BadGrasp(e.to_string())),
     }
 }
 

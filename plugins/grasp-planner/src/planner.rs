@@ -168,11 +168,9 @@ impl GraspPlanner for Paper {
         let params = SearchParams {
             max_samples: opts.max_samples,
             delta_f: opts.delta_f.unwrap_or(self.params.search.delta_f),
-            // A requested δf is the paper's rule alone: no exact acceptance below it.
-            exact_safety: match opts.delta_f {
-                Some(_) => f64::INFINITY,
-                None => self.params.search.exact_safety,
-            },
+            // A requested δf is the paper's rule: no acceptance below it.
+            paper_rule: opts.delta_f.is_some(),
+            hold: opts.hold,
             contact_distance: hand.contact_distance,
             ..self.params.search.clone()
         };

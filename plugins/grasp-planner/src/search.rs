@@ -20,11 +20,12 @@
 //! the ellipsoid margin, asks the certificates of earlier samples' weight
 //! programs whether this one can still hold the weight ([`WeightHints`]),
 //! checks the returned-grasp guarantees ([`crate::verify::check_grasp`]) and
-//! last runs the exact friction-cone program (`tsukami-grasp`), the costliest
-//! test: a grasp at margin ≥ δf must
-//! hold its weight there; one below δf (the ellipsoid is an inner
-//! approximation) is accepted when it is in exact force closure and holds
-//! [`SearchParams::exact_safety`] times its weight. The
+//! last runs the exact programs (`tsukami-grasp`), the costliest tests: the
+//! weight program, then the kit's hold test (exact force closure and every
+//! disturbance of the request's set balanced by forces the finger joints'
+//! torques can make, `tsukami_planner_kit::blocks::hold`). The ellipsoid
+//! margin ranks; only with the paper's rule ([`SearchParams::paper_rule`])
+//! must it reach δf as well. The
 //! generator is ChaCha8 seeded by the caller: the same seed, same result. The
 //! cancel flag and the deadline are checked before every sample (a sample
 //! takes well under a millisecond).
@@ -48,11 +49,15 @@ use tsukami_grasp::exact::{
 use tsukami_grasp::grasp::Grasp;
 use tsukami_grasp::grasp_matrix::Wrench;
 
+use tsukami_msgs::planner::HoldRequest;
+use tsukami_planner_kit::blocks::hold::{hold, HoldContact, HoldProblem};
+use tsukami_planner_kit::blocks::wrap::{style_check, StyleRule};
+
 use crate::finger_closing::{close_fingers, FingerContact};
 use crate::hand::HandModel;
 use crate::link_sets::LinkSets;
 use crate::object::PlanObject;
-use crate::verify::check_grasp;
+use crate::verify::{check_grasp, PENETRATION_TOLERANCE};
 use crate::whole_body::{Stage, StageJoints};
 
 /// Gravity (world frame, m/s²).
@@ -75,10 +80,13 @@ pub struct SearchParams {
     pub squat_offset: (f64, f64),
     /// Finger-closing distance threshold (m).
     pub contact_distance: f64,
-    /// A sample below the ellipsoid margin δf is still accepted when the
-    /// exact test finds force closure and the contacts hold this many times
-    /// the weight (the ellipsoid of eq. (10) is an inner approximation).
-    pub exact_safety: f64,
+    /// The paper's rule: a sample must reach the ellipsoid margin δf (a
+    /// request that sets δf). Otherwise the ellipsoid, an inner
+    /// approximation of eq. (10), only ranks: the exact tests decide.
+    pub paper_rule: bool,
+    /// What an accepted sample must resist (the kit's hold test,
+    /// `tsukami_planner_kit::blocks::hold`, the same the verification applies).
+    pub hold: HoldRequest,
 }
 
 impl Default for SearchParams {
@@ -91,7 +99,8 @@ impl Default for SearchParams {
             finger_offset: 0.12,
             squat_offset: (-0.12, 0.04),
             contact_distance: 0.002,
-            exact_safety: 2.0,
+            paper_rule: false,
+            hold: HoldRequest::default(),
         }
     }
 }
@@ -143,14 +152,19 @@ pub enum Outcome {
 }
 
 /// The reasons a sample is rejected, in the order of [`Counters::rejections`].
-pub const REJECTION_REASONS: [&str; 6] = [
+pub const REJECTION_REASONS: [&str; 7] = [
     "ik",
     "collision before closing",
     "finger closing",
     "collision after closing",
     "force closure",
     "verification",
+    "no wrap",
 ];
+
+/// The gap (m) a palm-contact grasp type leaves between palm and object
+/// before the fingers close: the palm then touches within the contact distance.
+pub const PALM_GAP: f64 = 0.0005;
 
 /// Running counters shared across searches of one plan.
 #[derive(Debug, Clone, Default)]
@@ -160,7 +174,7 @@ pub struct Counters {
     /// Best ellipsoid margin seen.
     pub best_margin: Option<f64>,
     /// Why samples were rejected, per [`REJECTION_REASONS`].
-    pub rejections: [u32; 6],
+    pub rejections: [u32; 7],
     /// What blocked the collision-rejected samples: `"<link> vs <obstacle>"`
     /// (or `"… vs <link>"` for self-collision) with counts.
     pub blockers: BTreeMap<String, u32>,
@@ -236,7 +250,7 @@ pub fn search(
             counters.reject(1, Some(why));
             continue;
         }
-        let Some(contacts) = close_fingers(
+        let Some(mut contacts) = close_fingers(
             hand,
             t,
             &mut q,
@@ -248,6 +262,19 @@ pub fn search(
             counters.reject(2, None);
             continue;
         };
+        if g.palm_contact {
+            contacts.extend(palm_contact(hand, &fk, object, p.contact_distance));
+        }
+        let rule = StyleRule {
+            style: g.style,
+            palm_contact: g.palm_contact,
+            palm: hand.palm,
+            approach: palm.rotation * g.approach(),
+        };
+        if let Err(why) = style_check(&rule, &hold_contacts(&contacts)) {
+            counters.reject(6, Some(why));
+            continue;
+        }
         if let Some(why) = links.blocked(hand, &fk, object, ctx.env, true) {
             counters.reject(3, Some(why));
             continue;
@@ -281,13 +308,15 @@ struct Closed<'a> {
 }
 
 /// The force tests of a closed hand: its ellipsoid margin (eq. (10)) when
-/// it is accepted, `None` (the rejection counted) otherwise. Eq. (10)'s
-/// margin reached: the exact friction cones must confirm it. Not reached:
-/// the ellipsoid is an inner approximation, so the exact test decides, with
-/// the safety factor `exact_safety` on the weight. A certificate of an
-/// earlier sample may already rule the sample out (cheap); then the
+/// it is accepted, `None` (the rejection counted) otherwise. The margin
+/// ranks and, with the paper's rule ([`SearchParams::paper_rule`], a
+/// request that sets δf), must reach δf; otherwise the ellipsoid, an inner
+/// approximation, decides nothing. A certificate of an earlier sample may
+/// rule the sample out (cheap: it cannot hold its weight); then the
 /// guarantees of a returned grasp, on the final posture; then the exact
-/// programs, the costliest test (their time is added to `exact_ms`).
+/// weight program and the kit's hold test (closure and the disturbance set
+/// with the joints' torques), the costliest tests (their time is added to
+/// `exact_ms`).
 fn accept(
     ctx: &SearchContext<'_>,
     closed: &Closed<'_>,
@@ -302,11 +331,11 @@ fn accept(
     if counters.best_margin.is_none_or(|b| margin > b) {
         counters.best_margin = Some(margin);
     }
-    let safety = match margin >= p.delta_f {
-        true => 1.0,
-        false => p.exact_safety,
-    };
-    if counters.hints.rule_out(ctx.object, &grasp, safety) {
+    if margin < p.delta_f && p.paper_rule {
+        counters.reject(4, None);
+        return None;
+    }
+    if counters.hints.rule_out(ctx.object, &grasp, 1.0) {
         counters.reject(4, None);
         return None;
     }
@@ -323,13 +352,58 @@ fn accept(
         return None;
     }
     let t_exact = Instant::now();
-    let exact = exact_resists(ctx.object, &grasp, safety, &mut counters.hints);
+    let exact = exact_resists(ctx.object, &grasp, 1.0, &mut counters.hints)
+        && holds(ctx, closed);
     *exact_ms += t_exact.elapsed().as_secs_f64() * 1e3;
     if !exact {
         counters.reject(4, None);
         return None;
     }
     Some(margin)
+}
+
+/// The palm as a contact when it is within `threshold` of the object: the
+/// nearest point on the object, the palm's push as the inward normal.
+fn palm_contact(
+    hand: &HandModel,
+    fk: &FkState,
+    object: &CollisionObject,
+    threshold: f64,
+) -> Option<FingerContact> {
+    let p = hand
+        .collision
+        .link_object_proximity(fk, hand.palm, object, threshold)?;
+    (p.distance >= -PENETRATION_TOLERANCE && p.distance < threshold).then(|| FingerContact {
+        link: hand.palm,
+        position: p.point_on_object,
+        normal: -p.normal.into_inner(),
+        f_max: hand.max_finger_force,
+        distance: p.distance,
+    })
+}
+
+/// The contacts as the kit's hold and style rules take them.
+fn hold_contacts(contacts: &[FingerContact]) -> Vec<HoldContact> {
+    contacts
+        .iter()
+        .map(|c| (c.link, c.position, c.normal))
+        .collect()
+}
+
+/// The kit's hold test on a closed hand (the rule the verification applies).
+fn holds(ctx: &SearchContext<'_>, closed: &Closed<'_>) -> bool {
+    let (hand, object) = (ctx.hand, ctx.object);
+    let problem = HoldProblem {
+        model: &hand.robot,
+        fk: closed.fk,
+        joints: &hand.hand_joints,
+        cap: hand.max_finger_force,
+        mass: object.mass,
+        mu: object.mu,
+        com: object.center_of_mass,
+        length: object.characteristic_length,
+    };
+    hold(&problem, &hold_contacts(closed.contacts), &ctx.params.hold).is_some_and(|v| v.holds())
 }
 
 /// The samples of Algorithm 1 around one nominal pose: Δp_p (the palm),
@@ -423,6 +497,10 @@ impl<'a> Sampler<'a> {
         if !sol.ok {
             return None;
         }
+        let (palm, sol) = match self.lay_on_palm(&palm, &sol.q, q) {
+            Some(laid) => laid,
+            None => (palm, sol),
+        };
         // The nominal's hand posture (the reference posture, or its
         // pre-flexed form, `crate::clearance`) + Δa_i.
         q.copy_from_slice(&sol.q);
@@ -437,6 +515,43 @@ impl<'a> Sampler<'a> {
             robot.apply_mimics(q);
         }
         Some(palm)
+    }
+}
+
+impl Sampler<'_> {
+    /// For a palm-contact grasp type: the palm moved along the approach until
+    /// it is [`PALM_GAP`] from the object, and the IK solution there (warm
+    /// started from `q_sol`); `None` for other types, a palm out of reach of
+    /// the object (3 cm), or no IK solution.
+    fn lay_on_palm(
+        &mut self,
+        palm: &Isometry3<f64>,
+        q_sol: &[f64],
+        q: &mut [f64],
+    ) -> Option<(Isometry3<f64>, tsukami_body::ik::IkSolution)> {
+        let hand = self.ctx.hand;
+        let g = &hand.config.grasp_types[self.t];
+        if !g.palm_contact {
+            return None;
+        }
+        let mut fk = FkState::new(&hand.robot);
+        hand.robot.forward_kinematics(q_sol, &mut fk);
+        let object = &self.ctx.object.collision;
+        let p = hand
+            .collision
+            .link_object_proximity(&fk, hand.palm, object, 0.03)?;
+        let a = palm.rotation * g.approach();
+        // The palm moves along the approach; the gap closes by the part of
+        // the move along the separating normal.
+        let along = p.normal.dot(&-a).max(0.3);
+        let shift = (p.distance - PALM_GAP) / along;
+        let moved = Isometry3::from_parts(
+            Translation3::from(palm.translation.vector + a * shift),
+            palm.rotation,
+        );
+        q.copy_from_slice(q_sol);
+        let sol = self.ik.solve(&moved, true, q, Some(self.q_nominal));
+        sol.ok.then_some((moved, sol))
     }
 }
 

@@ -1,4 +1,6 @@
-//! The largest normal force a finger can press with (`τ = Jᵀ f`).
+//! The forces a hand can make: the largest normal force a finger can press
+//! with (`τ = Jᵀ f`), and the joint torque limits of a whole contact set
+//! ([`hand_torques`]) that the hold test of `crate::verify` applies.
 //!
 //! ```
 //! // A finger whose Jacobian is missing presses with nothing: 0 N, not the cap.
@@ -11,6 +13,7 @@ use nalgebra::{DVector, Matrix3xX, Point3, Vector3};
 use tsukami_body::kinematics::{FkState, JointSelection};
 use tsukami_body::model::{JointId, LinkId, RobotModel};
 use tsukami_grasp::finger_force::max_finger_force;
+use tsukami_grasp::joint_torques::JointTorques;
 
 /// The force credited to a finger: its computed limit capped at `max`, and 0
 /// when it could not be computed (the one rule for every planner).
@@ -48,4 +51,32 @@ pub fn finger_force(
         max_finger_force(&j, &efforts, normal).ok().map(|f| f.force),
         max,
     )
+}
+
+/// The torque limits of a contact set at posture `fk`: per contact
+/// `(link, world point)`, its translational Jacobian over the hand's
+/// independent joints `joints` (mimic joints folded into their leaders, the
+/// columns of joints not above the link zero: a palm contact loads none),
+/// and the joints' efforts. `None` when `joints` is not a valid selection.
+pub fn hand_torques(
+    model: &RobotModel,
+    fk: &FkState,
+    joints: &[JointId],
+    contacts: &[(LinkId, Point3<f64>)],
+) -> Option<JointTorques> {
+    let sel = JointSelection::new(model, joints).ok()?;
+    let jacobians = contacts
+        .iter()
+        .map(|(link, point)| {
+            let local = fk.pose(*link).inverse() * point;
+            let j6 = model.jacobian(fk, *link, &local, &sel);
+            Matrix3xX::from_fn(sel.len(), |r, k| j6[(r, k)])
+        })
+        .collect();
+    let efforts = sel
+        .joints
+        .iter()
+        .map(|&j| model.joints[j].limits.effort)
+        .collect();
+    JointTorques::new(jacobians, efforts).ok()
 }

@@ -7,6 +7,8 @@ pub mod closing;
 pub mod collision;
 pub mod force;
 pub mod grasp_check;
+pub mod hold;
 pub mod posture;
 pub mod stages;
 pub mod surface;
+pub mod wrap;

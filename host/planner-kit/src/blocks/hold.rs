@@ -1,0 +1,140 @@
+//! The one hold rule every planner and the kit's verification apply.
+//!
+//! What: [`hold`] decides whether a closed hand holds the object — exact force
+//! closure and every disturbance of the request's set balanced by forces inside
+//! the reduced friction cones that the hand's joints can make
+//! (`tsukami_grasp::hold`) — and [`squeeze`] gives the joint torques and
+//! position targets that make the fingers press with such forces.
+//!
+//! Why: a planner that searches with one rule and a verification that checks
+//! another would return nothing, or return grasps the check was meant to stop.
+//! Both call this module with the same [`HoldProblem`].
+//!
+//! How: the contacts' Jacobians over the hand's independent joints come from
+//! [`crate::blocks::force::hand_torques`]; each contact's normal force is
+//! capped by the description's `max_finger_force` (an upper bound only: the
+//! joint rows limit first). Disturbances are built about the centre of mass
+//! with the problem's characteristic length.
+//!
+//! ```
+//! use tsukami_msgs::planner::{DisturbanceSet, HoldRequest};
+//! // The default request: closure and the standard set of twelve disturbances.
+//! let r = HoldRequest::default();
+//! assert_eq!(r.disturbances, DisturbanceSet::Standard);
+//! assert_eq!((r.com_error, r.friction_reserve, r.squeeze_share), (0.02, 0.2, 0.5));
+//! ```
+
+use nalgebra::{Point3, Vector3};
+use tsukami_body::kinematics::FkState;
+use tsukami_body::model::{JointId, LinkId, RobotModel};
+use tsukami_grasp::contact::Contact;
+use tsukami_grasp::grasp::Grasp;
+use tsukami_grasp::hold::{hold_test, Disturbances, HoldOptions, HoldVerdict};
+use tsukami_grasp::joint_torques::JointTorques;
+use tsukami_msgs::planner::{DisturbanceSet, HoldRequest, JointSqueeze};
+
+use crate::blocks::force::hand_torques;
+
+/// Gravity's magnitude, m/s² (the direction is the disturbance set's).
+pub const G: f64 = 9.81;
+
+/// What the hold test needs besides the contacts.
+pub struct HoldProblem<'a> {
+    /// The robot.
+    pub model: &'a RobotModel,
+    /// Its posture (the closed hand).
+    pub fk: &'a FkState,
+    /// The hand's independent joints.
+    pub joints: &'a [JointId],
+    /// Normal force cap per contact, N.
+    pub cap: f64,
+    /// Object mass, kg.
+    pub mass: f64,
+    /// Friction coefficient.
+    pub mu: f64,
+    /// Centre of mass, world.
+    pub com: Point3<f64>,
+    /// Torque scale length, m.
+    pub length: f64,
+}
+
+/// One contact as the hold test sees it: link, point and inward normal.
+pub type HoldContact = (LinkId, Point3<f64>, Vector3<f64>);
+
+/// The grasp and its torque limits, `None` when degenerate.
+pub fn setup(p: &HoldProblem<'_>, contacts: &[HoldContact]) -> Option<(Grasp, JointTorques)> {
+    let cs = contacts
+        .iter()
+        .map(|(_, x, n)| Contact::new(*x, *n).ok())
+        .collect::<Option<Vec<_>>>()?;
+    let limits = vec![p.cap; cs.len()];
+    let grasp = Grasp::with_force_limits(cs, limits, p.mu, p.length, p.com).ok()?;
+    let points: Vec<(LinkId, Point3<f64>)> = contacts.iter().map(|(l, x, _)| (*l, *x)).collect();
+    let torques = hand_torques(p.model, p.fk, p.joints, &points)?;
+    Some((grasp, torques))
+}
+
+/// The request's options as the grasp crate's.
+pub fn options(req: &HoldRequest) -> HoldOptions {
+    HoldOptions {
+        friction_reserve: req.friction_reserve,
+        require_closure: req.disturbances == DisturbanceSet::Standard,
+    }
+}
+
+/// The request's disturbance set for `grasp`.
+pub fn disturbances(p: &HoldProblem<'_>, grasp: &Grasp, req: &HoldRequest) -> Disturbances {
+    match req.disturbances {
+        DisturbanceSet::Standard => Disturbances::standard(grasp, p.mass, G, &p.com, req.com_error),
+        DisturbanceSet::Gravity => Disturbances::gravity(grasp, p.mass, G, &p.com),
+    }
+}
+
+/// The hold verdict of `contacts`; `None` when they make no valid grasp or
+/// the solver fails (the caller treats both as "does not hold").
+pub fn hold(
+    p: &HoldProblem<'_>,
+    contacts: &[HoldContact],
+    req: &HoldRequest,
+) -> Option<HoldVerdict> {
+    let (grasp, torques) = setup(p, contacts)?;
+    let set = disturbances(p, &grasp, req);
+    hold_test(&grasp, &torques, &set, &options(req)).ok()
+}
+
+/// The squeeze of `contacts` at posture `q`: for every hand joint its torque
+/// (`tsukami_grasp::hold::squeeze` with the request's share) and, with the
+/// stiffness `effort / servo_saturation`, its target, within its limits.
+pub fn squeeze(
+    p: &HoldProblem<'_>,
+    contacts: &[HoldContact],
+    q: &[f64],
+    servo_saturation: f64,
+    req: &HoldRequest,
+) -> Option<Vec<JointSqueeze>> {
+    let (grasp, torques) = setup(p, contacts)?;
+    let s = tsukami_grasp::hold::squeeze(&grasp, &torques, req.squeeze_share, &options(req))
+        .ok()?;
+    let out = p
+        .joints
+        .iter()
+        .zip(&s.torques)
+        .map(|(&j, &torque)| {
+            let joint = &p.model.joints[j];
+            let lim = joint.limits;
+            let stiffness = lim.effort / servo_saturation;
+            let target = match stiffness > 0.0 {
+                true => (q[j] + torque / stiffness).clamp(lim.lower, lim.upper),
+                false => q[j],
+            };
+            JointSqueeze {
+                joint: joint.name.clone(),
+                position: q[j],
+                torque,
+                stiffness,
+                target,
+            }
+        })
+        .collect();
+    Some(out)
+}
