@@ -245,7 +245,16 @@ fn hold_checks<P: GraspPlanner>(
     verdict.force_closure = v.force_closure;
     verdict.hold_margin = v.margin;
     verdict.disturbances = req.disturbances;
-    verdict.squeeze = squeeze(&problem, &contacts, &grasp.q, hand.servo_saturation, req)
-        .ok_or("no squeeze the joints can make balances the contacts")?;
+    let gaps: Vec<f64> = grasp
+        .contacts
+        .iter()
+        .map(|c| {
+            hand.collision
+                .link_object_proximity(&fk, c.link, &object.collision, 0.01)
+                .map_or(0.0, |p| p.distance.max(0.0))
+        })
+        .collect();
+    let s = squeeze(&problem, &contacts, &gaps, &grasp.q, hand.servo_saturation, req);
+    verdict.squeeze = s.ok_or("no squeeze the joints can make balances the contacts")?;
     Ok(())
 }

@@ -104,10 +104,15 @@ pub fn hold(
 
 /// The squeeze of `contacts` at posture `q`: for every hand joint its torque
 /// (`tsukami_grasp::hold::squeeze` with the request's share) and, with the
-/// stiffness `effort / servo_saturation`, its target, within its limits.
+/// stiffness `effort / servo_saturation`, its target, within its limits. The
+/// target also closes each contact's remaining gap (`gaps[i]`, m: a finger
+/// stops within the contact distance, not on the surface): the least-norm
+/// joint motion that moves every contact point by its gap along its normal,
+/// so the whole servo error presses.
 pub fn squeeze(
     p: &HoldProblem<'_>,
     contacts: &[HoldContact],
+    gaps: &[f64],
     q: &[f64],
     servo_saturation: f64,
     req: &HoldRequest,
@@ -115,16 +120,18 @@ pub fn squeeze(
     let (grasp, torques) = setup(p, contacts)?;
     let s = tsukami_grasp::hold::squeeze(&grasp, &torques, req.squeeze_share, &options(req))
         .ok()?;
+    let close = gap_motion(&torques, contacts, gaps);
     let out = p
         .joints
         .iter()
         .zip(&s.torques)
-        .map(|(&j, &torque)| {
+        .zip(close)
+        .map(|((&j, &torque), dq)| {
             let joint = &p.model.joints[j];
             let lim = joint.limits;
             let stiffness = lim.effort / servo_saturation;
             let target = match stiffness > 0.0 {
-                true => (q[j] + torque / stiffness).clamp(lim.lower, lim.upper),
+                true => (q[j] + dq + torque / stiffness).clamp(lim.lower, lim.upper),
                 false => q[j],
             };
             JointSqueeze {
@@ -137,4 +144,31 @@ pub fn squeeze(
         })
         .collect();
     Some(out)
+}
+
+/// The least-norm joint motion `δq` with `nᵢᵀ Jᵢ δq = gapᵢ` for every contact
+/// that loads a joint (rows of contacts the structure carries are dropped);
+/// zeros when the rows are degenerate.
+fn gap_motion(torques: &JointTorques, contacts: &[HoldContact], gaps: &[f64]) -> Vec<f64> {
+    let m = torques.joints();
+    let rows: Vec<(nalgebra::RowDVector<f64>, f64)> = contacts
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| torques.loads(*i))
+        .map(|(i, c)| {
+            let r = torques.rows(i, &nalgebra::Matrix3::identity());
+            let row = nalgebra::RowDVector::from_fn(m, |_, j| r.column(j).dot(&c.2));
+            (row, gaps.get(i).copied().unwrap_or(0.0).max(0.0))
+        })
+        .collect();
+    if rows.is_empty() {
+        return vec![0.0; m];
+    }
+    let a = nalgebra::DMatrix::from_rows(&rows.iter().map(|r| r.0.clone()).collect::<Vec<_>>());
+    let d = nalgebra::DVector::from_iterator(rows.len(), rows.iter().map(|r| r.1));
+    let aat = &a * a.transpose();
+    match aat.try_inverse() {
+        Some(inv) => (a.transpose() * inv * d).iter().copied().collect(),
+        None => vec![0.0; m],
+    }
 }
