@@ -453,8 +453,10 @@ pub struct HoldRequest {
     /// `(1 − friction_reserve) μ` (default 0.2; 0 to 0.9).
     #[serde(default = "default_friction_reserve")]
     pub friction_reserve: f64,
-    /// Share of each finger joint's effort the squeeze may use; the rest is
-    /// left for disturbances (default 0.5; above 0, at most 1).
+    /// Share of each finger joint's effort the squeeze may use on its most
+    /// loaded joint; the rest is headroom (default 0.9; above 0, at most 1).
+    /// A firm squeeze is what holds in simulation: 0.5 held 49 % of the
+    /// physics benchmark's grasps, 0.9 held 65 % (`docs/benchmarks.md`).
     #[serde(default = "default_squeeze_share")]
     pub squeeze_share: f64,
 }
@@ -466,7 +468,7 @@ fn default_friction_reserve() -> f64 {
     0.2
 }
 fn default_squeeze_share() -> f64 {
-    0.5
+    0.9
 }
 
 impl Default for HoldRequest {

@@ -21,7 +21,7 @@
 //! // The default request: closure and the standard set of twelve disturbances.
 //! let r = HoldRequest::default();
 //! assert_eq!(r.disturbances, DisturbanceSet::Standard);
-//! assert_eq!((r.com_error, r.friction_reserve, r.squeeze_share), (0.02, 0.2, 0.5));
+//! assert_eq!((r.com_error, r.friction_reserve, r.squeeze_share), (0.02, 0.2, 0.9));
 //! ```
 
 use nalgebra::{Point3, Vector3};
