@@ -185,6 +185,58 @@ pub fn verify<P: GraspPlanner>(
     Ok(verdict)
 }
 
+/// The kit's hold problem for the hand of `world` at posture `fk`.
+fn hold_problem<'a, P: GraspPlanner>(
+    world: &'a World<'_, P>,
+    fk: &'a FkState,
+    length: f64,
+) -> HoldProblem<'a> {
+    let (hand, object) = (world.hand(), world.object);
+    HoldProblem {
+        model: &world.robot.model,
+        fk,
+        joints: &hand.joints,
+        cap: hand.max_finger_force,
+        mass: object.mass,
+        mu: object.mu,
+        com: object.center_of_mass,
+        length,
+    }
+}
+
+fn hold_contacts(contacts: &[FingerContact]) -> Vec<HoldContact> {
+    contacts
+        .iter()
+        .map(|c| (c.link, c.position, c.normal))
+        .collect()
+}
+
+/// Whether the closed hand at `fk` holds the object with `contacts` under the
+/// request `req` (closure when the set requires it, every disturbance within
+/// the joints' torques): the verdict, or why not. Planners call it in their
+/// loops; the verification of every reply calls it too.
+pub fn holds<P: GraspPlanner>(
+    world: &World<'_, P>,
+    fk: &FkState,
+    contacts: &[FingerContact],
+    length: f64,
+    req: &HoldRequest,
+) -> Result<tsukami_grasp::hold::HoldVerdict, String> {
+    let problem = hold_problem(world, fk, length);
+    let v = hold(&problem, &hold_contacts(contacts), req)
+        .ok_or("the hold test could not be solved")?;
+    if req.disturbances == DisturbanceSet::Standard && !v.force_closure {
+        return Err("the contacts are not in force closure".into());
+    }
+    if !v.holds() {
+        return Err(format!(
+            "the joints' torques cannot hold the disturbances: the worst is resisted {:.2} times",
+            v.margin
+        ));
+    }
+    Ok(v)
+}
+
 /// The rule of the grasp's style ([`crate::blocks::wrap`]): the approach and
 /// palm requirement of its type in the hand's grasp-type file, or — for a
 /// type that file does not list (another planner's) — the palm normal and
@@ -216,32 +268,10 @@ fn hold_checks<P: GraspPlanner>(
     let (model, hand, object) = (&world.robot.model, world.hand(), world.object);
     let mut fk = FkState::new(model);
     model.forward_kinematics(&grasp.q, &mut fk);
-    let problem = HoldProblem {
-        model,
-        fk: &fk,
-        joints: &hand.joints,
-        cap: hand.max_finger_force,
-        mass: object.mass,
-        mu: object.mu,
-        com: object.center_of_mass,
-        length,
-    };
-    let contacts: Vec<HoldContact> = grasp
-        .contacts
-        .iter()
-        .map(|c| (c.link, c.position, c.normal))
-        .collect();
+    let problem = hold_problem(world, &fk, length);
+    let contacts = hold_contacts(&grasp.contacts);
     style_check(&style_rule(world, grasp, &fk), &contacts)?;
-    let v = hold(&problem, &contacts, req).ok_or("the hold test could not be solved")?;
-    if req.disturbances == DisturbanceSet::Standard && !v.force_closure {
-        return Err("the contacts are not in force closure".into());
-    }
-    if !v.holds() {
-        return Err(format!(
-            "the joints' torques cannot hold the disturbances: the worst is resisted {:.2} times",
-            v.margin
-        ));
-    }
+    let v = holds(world, &fk, &grasp.contacts, length, req)?;
     verdict.force_closure = v.force_closure;
     verdict.hold_margin = v.margin;
     verdict.disturbances = req.disturbances;

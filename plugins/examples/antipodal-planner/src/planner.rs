@@ -11,8 +11,9 @@
 //!    of the object (kit block `collision`);
 //! 5. **closing** — each pinching finger flexes until it touches (kit block
 //!    `closing`), then obstacles and self-collision again;
-//! 6. **force closure** — accepted when the exact friction-cone test resists
-//!    the weight (kit `verify::force_closure`).
+//! 6. **holding** — accepted when the kit's hold test passes (kit
+//!    `verify::holds`: exact force closure and the request's disturbances
+//!    within the joints' torques, `PlanOptions::hold`).
 //!
 //! Each failed step names its reason (`run.reject`), which the kit reports.
 //! `palm_criterion`, `delta_f` and `max_candidates` belong to the paper's
@@ -50,6 +51,7 @@ struct Sample<'a, 'w> {
     rest: Vec<f64>,
     shoulder: Vector3<f64>,
     rng: ChaCha8Rng,
+    hold: tsukami_msgs::planner::HoldRequest,
 }
 
 /// Size class from the object's middle box extent (its usual pinch width).
@@ -112,6 +114,7 @@ impl GraspPlanner for Antipodal {
             rest,
             shoulder,
             rng,
+            hold: o.hold,
         };
         let stages = robot.stages(hand, o.whole_body);
         for (si, stage) in stages.iter().enumerate() {
@@ -187,6 +190,8 @@ impl Sample<'_, '_> {
         if !v.exact_resists_weight {
             return Err("contacts cannot resist the weight");
         }
+        verify::holds(w, &self.fk, &contacts, length, &self.hold)
+            .map_err(|_| "contacts cannot hold the disturbances")?;
         Ok((
             q,
             contacts,
