@@ -250,22 +250,15 @@ fn a_flood_of_refused_requests_holds_up_neither_the_periods_nor_a_stop() {
     // run goes, then its start, -1 rad, is away from the state).
     let second = line("r_elbow", -1.0, -1.2, 1.0);
     let answered = AtomicUsize::new(0);
+    let (client_ref, answered_ref) = (&client, &answered);
     let run = std::thread::scope(|s| {
         let run = s.spawn(|| (execute(&client, &long), Instant::now()));
         while rx.recv_timeout(T).unwrap().status != "executing" {}
         let (tick0, t0) = (latest_tick(&client), Instant::now());
         let flood: Vec<_> = (0..CLIENTS)
             .map(|c| {
-                let (client, answered) = (&client, &answered);
-                let (unknown, second) = (&unknown, &second);
-                s.spawn(move || {
-                    for k in 0..FLOOD / CLIENTS {
-                        let bad = if (k + c) % 2 == 0 { unknown } else { second };
-                        let reply = execute(client, bad).unwrap();
-                        assert!(!reply.accepted, "{reply:?}");
-                        answered.fetch_add(1, Ordering::Relaxed);
-                    }
-                })
+                let bad = [&unknown, &second];
+                s.spawn(move || refused(client_ref, bad, c, FLOOD / CLIENTS, answered_ref))
             })
             .collect();
         // The stop goes out when half the flood is answered.
@@ -326,6 +319,22 @@ fn a_flood_of_refused_requests_holds_up_neither_the_periods_nor_a_stop() {
         run.stop_to_end
     );
     node.shutdown();
+}
+
+/// `n` requests from one client, alternating between the two `bad` trajectories
+/// (starting with `bad[c % 2]`), each refused; counted in `answered`.
+fn refused(
+    client: &BusClient,
+    bad: [&JointTrajectory; 2],
+    c: usize,
+    n: usize,
+    answered: &AtomicUsize,
+) {
+    for k in 0..n {
+        let reply = execute(client, bad[(k + c) % 2]).unwrap();
+        assert!(!reply.accepted, "{reply:?}");
+        answered.fetch_add(1, Ordering::Relaxed);
+    }
 }
 
 struct FloodRun {

@@ -282,6 +282,28 @@ impl View<'_> {
     fn exhausted(&self) -> bool {
         self.work.get() > self.params.max_work
     }
+
+    /// Said in every "not found" when the budget ran out before the fits did.
+    fn budget_note(&self) -> String {
+        if !self.exhausted() {
+            return String::new();
+        }
+        format!(
+            "; the work budget ran out: {} point evaluations spent, the limit is {} (max_work)",
+            self.work.get(),
+            self.params.max_work
+        )
+    }
+}
+
+/// Thins every cluster and segment of more than `max` points to `max`, evenly.
+fn thin_large(clusters: &mut [Vec<Point3<f64>>], segments: &mut [Segment], max: usize) {
+    let all = clusters
+        .iter_mut()
+        .chain(segments.iter_mut().map(|s| &mut s.points));
+    for points in all.filter(|p| p.len() > max) {
+        *points = thin(points, max);
+    }
 }
 
 /// A coarse fit on a segment and its rank.
@@ -313,14 +335,7 @@ pub fn detect_with(
     };
     let size = 2.0 * template.radius;
     let (mut clusters, mut segments) = segments(&cloud, &planes, grid, size, &params.segment);
-    for points in clusters
-        .iter_mut()
-        .chain(segments.iter_mut().map(|s| &mut s.points))
-    {
-        if points.len() > params.max_segment_points {
-            *points = thin(points, params.max_segment_points);
-        }
-    }
+    thin_large(&mut clusters, &mut segments, params.max_segment_points);
     let t_segment = started.elapsed();
     let view = View {
         template,
@@ -346,16 +361,7 @@ pub fn detect_with(
         work = view.work.get(),
         "detect"
     );
-    // Said in every "not found" when the budget ran out before the fits did.
-    let budget = if view.exhausted() {
-        format!(
-            "; the work budget ran out: {} point evaluations spent, the limit is {} (max_work)",
-            view.work.get(),
-            params.max_work
-        )
-    } else {
-        String::new()
-    };
+    let budget = view.budget_note();
     let Some(best) = best else {
         return not_found(
             format!(
