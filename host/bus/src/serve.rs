@@ -122,10 +122,11 @@ mod tests {
     #[test]
     fn bad_payloads_are_named() {
         let big = vec![b' '; MAX_PAYLOAD_BYTES + 1];
-        assert_eq!(
-            parse_payload::<Req>(&big).unwrap_err().error.code,
-            ErrorCode::PayloadTooLarge
-        );
+        let too_large = parse_payload::<Req>(&big).unwrap_err().error;
+        assert_eq!(too_large.code, ErrorCode::PayloadTooLarge);
+        assert!(too_large.message.contains("16777216"), "{}", too_large.message);
+        assert_eq!(too_large.details.unwrap()["limit"], MAX_PAYLOAD_BYTES);
+        assert_eq!(crate::reassembly_cap(MAX_PAYLOAD_BYTES), 33 << 20);
         assert_eq!(
             parse_payload::<Req>(b"{").unwrap_err().error.code,
             ErrorCode::MalformedJson
