@@ -384,6 +384,10 @@ fn vision_plan_execute_kill_restart(t: Topology) {
     let info = client.wait_for_component("controller", T).unwrap();
     assert_eq!(info.version, env!("CARGO_PKG_VERSION"));
     client.wait_for_component("vision", T).unwrap();
+    // `<ns>/*/info` lists both components (each answers on its own key).
+    let listed = client.components(Duration::from_secs(5)).unwrap();
+    let names: Vec<&str> = listed.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, ["controller", "vision"], "{listed:?}");
     let states = StateStream::subscribe(&client).unwrap();
 
     let (detected, goal) = detect_and_plan(&client, &scene);

@@ -120,6 +120,23 @@ impl Executor {
             return Err("busy: a trajectory is running; stop it first (`controller/stop`)".into());
         }
         let plan = Plan::check(trajectory, &self.table, &self.positions, tolerance)?;
+        self.begin(plan);
+        Ok(())
+    }
+
+    /// Starts a plan already checked against the robot ([`Plan::for_robot`]) when
+    /// nothing runs and its first point is within `tolerance` of the current state.
+    /// A refused plan changes nothing.
+    pub fn start_plan(&mut self, plan: Plan, tolerance: f64) -> Result<(), String> {
+        if self.run.is_some() {
+            return Err("busy: a trajectory is running; stop it first (`controller/stop`)".into());
+        }
+        plan.check_start(&self.table, &self.positions, tolerance)?;
+        self.begin(plan);
+        Ok(())
+    }
+
+    fn begin(&mut self, plan: Plan) {
         let n = plan.joints().len();
         self.run = Some(Run {
             plan,
@@ -129,7 +146,6 @@ impl Executor {
         });
         self.status = "executing";
         self.trajectory_time = Some(0.0);
-        Ok(())
     }
 
     /// One control period. Returns the outcome when this period ended the run.

@@ -7,16 +7,24 @@
 //!
 //! Why: one thread owns the [`Executor`], so requests are handled in arrival order
 //! between periods and nothing is shared but a stop flag and the latest state; zenoh's
-//! callbacks only parse and hand over.
+//! callbacks only parse and hand over. The control period is kept whatever arrives:
+//! a flood of requests, good or bad, can neither delay a period nor a stop.
 //!
-//! How: the control thread runs one period per `dt / speed` of wall time while a
-//! trajectory runs (`speed` = ∞: as fast as it can) and one per `dt` while idle; it
-//! waits on its request channel between periods, so a request is taken at once.
-//! Shutting down ends a running trajectory as a fault and answers its caller.
+//! How: three stages. zenoh's callback parses a request and queues it (at most
+//! [`EXECUTE_QUEUE`] waiting; more are refused `busy`). A checker thread runs the
+//! checks that need only the robot model ([`Plan::for_robot`]) and answers a
+//! refused trajectory itself. The control thread runs one period at each deadline —
+//! deadlines `dt / speed` apart while a trajectory runs (`speed` = ∞: back to back)
+//! and `dt` apart while idle — and between deadlines takes checked requests (the
+//! start and busy checks are a few comparisons), so a request never moves the next
+//! deadline. Stop is a flag every period reads. Shutting down ends a running
+//! trajectory as a fault and answers its caller.
 
 use crate::executor::Executor;
+use crate::joints::JointTable;
+use crate::trajectory::Plan;
 use anyhow::Result;
-use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError, SyncSender, TrySendError};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -47,9 +55,23 @@ impl Default for NodeOptions {
     }
 }
 
-/// A request handed from zenoh's callback to the control thread.
+/// How many `execute` requests may wait to be checked; more are refused `busy`
+/// (the host's default `limits.max_queue`).
+pub const EXECUTE_QUEUE: usize = 8;
+
+/// A request handed from zenoh's callback to the checker thread.
 struct ExecuteJob {
     request: ExecuteRequest,
+    query: Query,
+}
+
+/// A request whose trajectory passed the robot-model checks, handed from the
+/// checker thread to the control thread.
+struct CheckedJob {
+    plan: Plan,
+    wait: bool,
+    joints: usize,
+    points: usize,
     query: Query,
 }
 
@@ -105,7 +127,12 @@ impl ControllerNode {
         let keys = component.keys().clone();
         let shared = Arc::new(Shared::default());
         *shared.latest.lock().unwrap_or_else(|e| e.into_inner()) = Some(executor.state());
-        let (jobs, queue) = mpsc::channel::<ExecuteJob>();
+        let (jobs, requests) = mpsc::sync_channel::<ExecuteJob>(EXECUTE_QUEUE);
+        let (checked, queue) = mpsc::sync_channel::<CheckedJob>(1);
+        let table = executor.table().clone();
+        std::thread::Builder::new()
+            .name("controller-check".into())
+            .spawn(move || check_requests(&table, requests, checked))?;
         let publisher = component.publisher(&keys.controller_state())?;
         let queryables = vec![
             serve_execute(&component, jobs)?,
@@ -146,23 +173,56 @@ impl ControllerNode {
     }
 }
 
-fn serve_execute(component: &Component, jobs: Sender<ExecuteJob>) -> Result<Queryable<()>> {
-    let jobs = Mutex::new(jobs);
+fn serve_execute(component: &Component, jobs: SyncSender<ExecuteJob>) -> Result<Queryable<()>> {
     let key = component.keys().controller_execute();
     component.serve_query(&key, move |query| {
         match parse_query::<ExecuteRequest>(&query) {
-            Ok(request) => {
-                let sent = jobs
-                    .lock()
-                    .unwrap_or_else(|e| e.into_inner())
-                    .send(ExecuteJob { request, query });
-                if let Err(mpsc::SendError(job)) = sent {
-                    reply_rejected(&job.query, "the controller is shutting down".into());
+            Ok(request) => match jobs.try_send(ExecuteJob { request, query }) {
+                Ok(()) => {}
+                Err(TrySendError::Full(job)) => reply_error(
+                    &job.query,
+                    tsukami_msgs::ErrorReply::new(
+                        tsukami_msgs::ErrorCode::Busy,
+                        format!(
+                            "the controller has {EXECUTE_QUEUE} execute requests waiting to be checked; retry later"
+                        ),
+                    ),
+                ),
+                Err(TrySendError::Disconnected(job)) => {
+                    reply_rejected(&job.query, "the controller is shutting down".into())
                 }
-            }
+            },
             Err(error) => reply_error(&query, error),
         }
     })
+}
+
+/// The checker thread: the robot-model checks of every request, in arrival order;
+/// a refused one is answered here, a passed one goes on to the control thread.
+/// Ends when zenoh drops the `execute` callback (and with it `requests`' sender).
+fn check_requests(
+    table: &JointTable,
+    requests: Receiver<ExecuteJob>,
+    checked: SyncSender<CheckedJob>,
+) {
+    for job in requests {
+        let trajectory = &job.request.trajectory;
+        match Plan::for_robot(trajectory, table) {
+            Ok(plan) => {
+                let job = CheckedJob {
+                    plan,
+                    wait: job.request.wait,
+                    joints: trajectory.joint_names.len(),
+                    points: trajectory.points.len(),
+                    query: job.query,
+                };
+                if let Err(mpsc::SendError(job)) = checked.send(job) {
+                    reply_rejected(&job.query, "the controller is shutting down".into());
+                }
+            }
+            Err(reason) => reply_rejected(&job.query, reason),
+        }
+    }
 }
 
 fn serve_stop(component: &Component, shared: Arc<Shared>) -> Result<Queryable<()>> {
@@ -224,57 +284,67 @@ struct ControlLoop {
 }
 
 impl ControlLoop {
-    fn run(mut self, queue: Receiver<ExecuteJob>) {
-        let idle_period = Duration::from_secs_f64(self.executor.dt());
-        let run_period = Duration::from_secs_f64(self.executor.dt() / self.options.speed);
-        let mut next = Instant::now();
+    /// Periods at their deadlines; checked requests taken between them. Handling a
+    /// request never moves a deadline, so the period holds under any request load.
+    fn run(mut self, queue: Receiver<CheckedJob>) {
+        let mut next = Instant::now() + self.period_length();
+        let mut open = true;
         loop {
             if self.shutdown.is_triggered() {
-                if let Some(outcome) = self.executor.fault() {
-                    self.shared.flags().running = false;
-                    self.publish();
-                    self.end_run(
-                        outcome,
-                        Some("the controller shut down mid-run".into()),
-                        None,
-                    );
-                }
-                return;
+                return self.shut_down();
             }
-            let period = if self.executor.is_running() {
-                run_period
-            } else {
-                idle_period
-            };
-            next += period;
             let now = Instant::now();
-            if next < now {
-                next = now; // behind: do not try to catch up in a burst
+            if now >= next {
+                self.period();
+                next = next_deadline(next, self.period_length(), Instant::now());
             }
-            match queue.recv_timeout(next - now) {
-                Ok(job) => {
-                    self.take(job);
-                    continue;
-                }
+            let wait = next.saturating_duration_since(Instant::now());
+            if !open {
+                std::thread::sleep(wait);
+                continue;
+            }
+            match queue.recv_timeout(wait) {
+                Ok(job) => self.take(job),
                 Err(RecvTimeoutError::Timeout) => {}
-                Err(RecvTimeoutError::Disconnected) => {
-                    std::thread::sleep(next.saturating_duration_since(Instant::now()))
-                }
+                Err(RecvTimeoutError::Disconnected) => open = false,
             }
-            self.period();
         }
     }
 
-    /// A new request: start it, or refuse it with the reason.
-    fn take(&mut self, job: ExecuteJob) {
+    /// Wall time of the coming period: `dt / speed` while a trajectory runs, `dt`
+    /// while idle.
+    fn period_length(&self) -> Duration {
+        let dt = self.executor.dt();
+        if self.executor.is_running() {
+            Duration::from_secs_f64(dt / self.options.speed)
+        } else {
+            Duration::from_secs_f64(dt)
+        }
+    }
+
+    fn shut_down(&mut self) {
+        if let Some(outcome) = self.executor.fault() {
+            self.shared.flags().running = false;
+            self.publish();
+            self.end_run(
+                outcome,
+                Some("the controller shut down mid-run".into()),
+                None,
+            );
+        }
+    }
+
+    /// A checked request: start it, or refuse it with the reason (busy, or its
+    /// start away from the current state).
+    fn take(&mut self, job: CheckedJob) {
         match self
             .executor
-            .start(&job.request.trajectory, self.options.start_tolerance)
+            .start_plan(job.plan, self.options.start_tolerance)
         {
             Ok(()) => {
                 tracing::info!(
-                    joints = job.request.trajectory.joint_names.len(),
-                    points = job.request.trajectory.points.len(),
+                    joints = job.joints,
+                    points = job.points,
                     tick = self.executor.tick(),
                     "trajectory accepted"
                 );
@@ -282,7 +352,7 @@ impl ControlLoop {
                 flags.running = true;
                 flags.stop_requested_at = None;
                 drop(flags);
-                if job.request.wait {
+                if job.wait {
                     self.waiting = Some(job.query);
                 } else {
                     reply_json(&job.query, &accepted_reply());
@@ -345,6 +415,12 @@ impl ControlLoop {
             );
         }
     }
+}
+
+/// The deadline after `previous`, one `period` later; when the thread is already
+/// past it, now (one period at once, no burst to catch up).
+fn next_deadline(previous: Instant, period: Duration, now: Instant) -> Instant {
+    (previous + period).max(now)
 }
 
 fn accepted_reply() -> ExecuteReply {

@@ -56,11 +56,19 @@ impl Plan {
         current: &[f64],
         tolerance: f64,
     ) -> Result<Plan, String> {
+        let plan = Plan::for_robot(trajectory, table)?;
+        plan.check_start(table, current, tolerance)?;
+        Ok(plan)
+    }
+
+    /// The checks that need the robot model only, not its state: every rule of
+    /// [`Plan::check`] but the start. The controller runs them off its control
+    /// thread, so a flood of bad trajectories costs the control periods nothing.
+    pub fn for_robot(trajectory: &JointTrajectory, table: &JointTable) -> Result<Plan, String> {
         let joints = resolve_joints(&trajectory.joint_names, table)?;
         check_points(trajectory)?;
         let plan = build(trajectory, joints);
         plan.check_limits(trajectory, table)?;
-        plan.check_start(trajectory, table, current, tolerance)?;
         Ok(plan)
     }
 
@@ -125,14 +133,15 @@ impl Plan {
         Ok(())
     }
 
-    fn check_start(
+    /// Whether the plan's first point is within `tolerance` of `current` (table
+    /// order) for every joint it drives.
+    pub fn check_start(
         &self,
-        trajectory: &JointTrajectory,
         table: &JointTable,
         current: &[f64],
         tolerance: f64,
     ) -> Result<(), String> {
-        let first = &trajectory.points[0].positions;
+        let first = &self.start;
         for (j, &i) in self.joints.iter().enumerate() {
             let gap = (first[j] - current[i]).abs();
             if gap > tolerance {

@@ -29,6 +29,10 @@ use crate::error::{invalid, Result};
 /// Largest accepted image side, in pixels (bounds memory on any input).
 pub const MAX_SIDE: u32 = 4096;
 
+/// Most pixels in one image (1280 × 1024): bounds a detection's memory and work
+/// whatever the image holds (docs/components.md, "Bounds").
+pub const MAX_PIXELS: usize = 1280 * 1024;
+
 /// Pinhole intrinsics.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Intrinsics {
@@ -60,8 +64,9 @@ impl Intrinsics {
         }
     }
 
-    /// Checks sizes (1..=[`MAX_SIDE`]), finite positive focal lengths and a
-    /// finite principal point; the error names the field.
+    /// Checks sizes (1..=[`MAX_SIDE`] a side, at most [`MAX_PIXELS`] in all),
+    /// finite positive focal lengths and a finite principal point; the error names
+    /// the field.
     pub fn validate(&self) -> Result<()> {
         for (name, side) in [("width", self.width), ("height", self.height)] {
             if side == 0 || side > MAX_SIDE {
@@ -70,6 +75,17 @@ impl Intrinsics {
                     format!("{side} must be in 1..={MAX_SIDE}"),
                 ));
             }
+        }
+        if self.pixels() > MAX_PIXELS {
+            return Err(invalid(
+                "intrinsics",
+                format!(
+                    "{} x {} = {} pixels is over the limit of {MAX_PIXELS} pixels (1280 x 1024)",
+                    self.width,
+                    self.height,
+                    self.pixels()
+                ),
+            ));
         }
         for (name, f) in [("fx", self.fx), ("fy", self.fy)] {
             if !(f.is_finite() && f > 0.0) {

@@ -23,6 +23,10 @@
 //! visible-surface agreement ([`crate::freespace`]) for the directions the
 //! points leave free; then the full verification. The candidate with the
 //! highest confidence wins, reported in its symmetry class's canonical form.
+//! The work is bounded whatever the image holds: segments and clusters are
+//! thinned to [`DetectParams::max_segment_points`], and no more fits start once
+//! [`DetectParams::max_work`] point evaluations are spent (counted, not timed,
+//! so the answer does not depend on the machine).
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -43,6 +47,14 @@ use crate::resting::on_plane;
 use crate::segment::{segments, Grid, Segment, SegmentParams};
 use crate::template::ObjectTemplate;
 use crate::verify::{verify, Verdict, VerifyParams};
+
+/// Default [`DetectParams::max_segment_points`]: an object filling a 1280 × 1024
+/// image at stride 2 is about 60 000 points; the fits use at most 1200 of them.
+pub const MAX_SEGMENT_POINTS: usize = 20_000;
+/// Default [`DetectParams::max_work`], in point evaluations: ten times the most a
+/// detection in the tests' and benchmarks' 640 × 480 frames spends (measured:
+/// about 300,000).
+pub const MAX_WORK: u64 = 3_000_000;
 
 /// Settings of the pipeline.
 #[derive(Debug, Clone, PartialEq)]
@@ -89,7 +101,14 @@ pub struct DetectParams {
     /// A pose is reported only at this confidence or more.
     pub min_confidence: f64,
     /// Base-frame direction the x axis of a symmetric object's reported pose follows.
-    pub preferred_x: Vector3<f64>,
+    pub preferred_x: Vector3<f64>,    /// Most points of one segment (and of the cluster it is verified against):
+    /// a larger one is thinned evenly to this many (deterministic).
+    pub max_segment_points: usize,
+    /// The work budget of one detection, in point evaluations (a point of the
+    /// cloud, a point paired once by an ICP iteration or checked once by a
+    /// verification, a pixel looked at while gathering): no more fits are
+    /// started once it is spent.
+    pub max_work: u64,
 }
 
 impl Default for DetectParams {
@@ -139,6 +158,8 @@ impl Default for DetectParams {
             max_rest_gap: 0.02,
             min_confidence: 0.8,
             preferred_x: -Vector3::x(),
+            max_segment_points: MAX_SEGMENT_POINTS,
+            max_work: MAX_WORK,
         }
     }
 }
@@ -246,6 +267,43 @@ struct View<'a> {
     camera: &'a Camera,
     planes: &'a [FoundPlane],
     params: &'a DetectParams,
+    /// Point evaluations spent so far (see [`DetectParams::max_work`]).
+    work: std::cell::Cell<u64>,
+}
+
+impl View<'_> {
+    /// Counts `points` evaluations; false once the budget is spent.
+    fn spend(&self, points: usize) -> bool {
+        let spent = self.work.get().saturating_add(points as u64);
+        self.work.set(spent);
+        spent <= self.params.max_work
+    }
+
+    fn exhausted(&self) -> bool {
+        self.work.get() > self.params.max_work
+    }
+
+    /// Said in every "not found" when the budget ran out before the fits did.
+    fn budget_note(&self) -> String {
+        if !self.exhausted() {
+            return String::new();
+        }
+        format!(
+            "; the work budget ran out: {} point evaluations spent, the limit is {} (max_work)",
+            self.work.get(),
+            self.params.max_work
+        )
+    }
+}
+
+/// Thins every cluster and segment of more than `max` points to `max`, evenly.
+fn thin_large(clusters: &mut [Vec<Point3<f64>>], segments: &mut [Segment], max: usize) {
+    let all = clusters
+        .iter_mut()
+        .chain(segments.iter_mut().map(|s| &mut s.points));
+    for points in all.filter(|p| p.len() > max) {
+        *points = thin(points, max);
+    }
 }
 
 /// A coarse fit on a segment and its rank.
@@ -276,7 +334,8 @@ pub fn detect_with(
         stride: params.stride,
     };
     let size = 2.0 * template.radius;
-    let (clusters, segments) = segments(&cloud, &planes, grid, size, &params.segment);
+    let (mut clusters, mut segments) = segments(&cloud, &planes, grid, size, &params.segment);
+    thin_large(&mut clusters, &mut segments, params.max_segment_points);
     let t_segment = started.elapsed();
     let view = View {
         template,
@@ -284,6 +343,7 @@ pub fn detect_with(
         camera,
         planes: &planes,
         params,
+        work: std::cell::Cell::new(cloud.len() as u64),
     };
     let coarse = coarse_fits(&view, &segments);
     let t_coarse = started.elapsed();
@@ -298,12 +358,14 @@ pub fn detect_with(
         segment_ms = t_segment.as_secs_f64() * 1e3,
         coarse_ms = (t_coarse - t_segment).as_secs_f64() * 1e3,
         fine_ms = (started.elapsed() - t_coarse).as_secs_f64() * 1e3,
+        work = view.work.get(),
         "detect"
     );
+    let budget = view.budget_note();
     let Some(best) = best else {
         return not_found(
             format!(
-                "no object-sized cluster above the supporting plane ({} clusters, {} planes)",
+                "no object-sized cluster above the supporting plane ({} clusters, {} planes){budget}",
                 clusters.len(),
                 planes.len()
             ),
@@ -323,7 +385,7 @@ pub fn detect_with(
     if detection.confidence >= params.min_confidence {
         return Ok(Outcome::Found(detection));
     }
-    let reason = explain(&best.verdict, params.min_confidence);
+    let reason = explain(&best.verdict, params.min_confidence) + &budget;
     not_found(reason, Some(detection))
 }
 
@@ -351,6 +413,9 @@ fn coarse_fits(view: &View, segments: &[Segment]) -> Vec<Hypothesis> {
     let cam = view.camera.centre();
     let mut all: Vec<Hypothesis> = Vec::new();
     for (si, seg) in segments.iter().enumerate() {
+        if view.exhausted() {
+            break;
+        }
         let Some(m) = Moments::of(&seg.points) else {
             continue;
         };
@@ -361,8 +426,10 @@ fn coarse_fits(view: &View, segments: &[Segment]) -> Vec<Hypothesis> {
                 starts.extend(on_plane(template, &seg.points, &plane.plane, &cam));
             }
         }
+        let cost = pts.len() * (params.coarse.iterations + 1);
         let mut fits: Vec<Hypothesis> = starts
             .into_iter()
+            .take_while(|_| view.spend(cost))
             .map(|start| {
                 let fit = refine(template, &pts, Some(cam), start, &params.coarse);
                 Hypothesis {
@@ -408,6 +475,12 @@ fn best_fine(
     let mut best: Option<Candidate> = None;
     for h in coarse.iter().take(view.params.max_fine) {
         let seg = &segments[h.segment];
+        let p = view.params;
+        let cost = p.fine_points * (p.fine.iterations + p.exact_iterations)
+            + clusters[seg.parent].len();
+        if !view.spend(cost) {
+            break;
+        }
         let cand = fine_fit(view, &seg.points, &clusters[seg.parent], h.fit.pose);
         if best
             .as_ref()
@@ -505,7 +578,8 @@ fn thin(points: &[Point3<f64>], n: usize) -> Vec<Point3<f64>> {
     points.iter().step_by(step).copied().collect()
 }
 
-/// Full-resolution points within `gather` of the model at `pose`, off the planes.
+/// Full-resolution points within `gather` of the model at `pose`, off the planes
+/// (the region's pixels are counted as work).
 fn gather(view: &View, pose: &Isometry3<f64>) -> Vec<Point3<f64>> {
     let (template, params, camera) = (view.template, view.params, view.camera);
     let k = &camera.intrinsics;
@@ -521,6 +595,8 @@ fn gather(view: &View, pose: &Isometry3<f64>) -> Vec<Point3<f64>> {
         clamp(u + r + 1.0, k.width),
         clamp(v + r + 1.0, k.height),
     ];
+    // Every pixel of the region is looked at.
+    view.spend(region[2].saturating_sub(region[0]) as usize * region[3].saturating_sub(region[1]) as usize);
     let inv = pose.inverse();
     let gate2 = params.gather * params.gather;
     let centre = pose * template.moments.centroid;

@@ -19,7 +19,7 @@ use std::time::Duration;
 
 use serde_json::json;
 use tsukami_body::files::ModelRoots;
-use tsukami_bus::serve::{parse_query, reply_error, reply_json};
+use tsukami_bus::serve::{check_size, parse_query, reply_error, reply_json};
 use tsukami_bus::{BusClient, Component};
 use tsukami_msgs::keys::planner::SET_OBJECT;
 use tsukami_msgs::planner::{ObjectShape, SetObject};
@@ -152,12 +152,16 @@ pub fn serve(
     let keys = component.keys().clone();
     let (tx, rx) = sync_channel::<zenoh::query::Query>(QUEUE);
     let queryable = component.serve_query(&keys.vision_detect(), move |query| {
+        // An oversized request is refused here, before it takes a queue slot.
+        if let Err(error) = check_size(&query) {
+            return reply_error(&query, error);
+        }
         if let Err(TrySendError::Full(q)) = tx.try_send(query) {
             reply_error(
                 &q,
                 ErrorReply::new(
-                    ErrorCode::NotReady,
-                    format!("busy: {QUEUE} detections are queued"),
+                    ErrorCode::Busy,
+                    format!("busy: {QUEUE} detections are queued, the most that wait; retry later"),
                 ),
             );
         }

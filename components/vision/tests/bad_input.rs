@@ -182,3 +182,81 @@ fn service_names_bad_payloads_and_keeps_serving() {
     assert_eq!(err.error.code, ErrorCode::Infeasible);
     assert_eq!(err.error.details.unwrap()["reason"], "not_found");
 }
+
+/// A camera of `width` × `height` pixels looking down from the head's height.
+fn big_camera(width: u32, height: u32) -> Camera {
+    Camera {
+        intrinsics: Intrinsics {
+            width,
+            height,
+            fx: 1050.0,
+            fy: 1050.0,
+            cx: (width as f64 - 1.0) / 2.0,
+            cy: (height as f64 - 1.0) / 2.0,
+        },
+        ..camera()
+    }
+}
+
+/// Every pixel at 1 mm: a small PNG (it compresses to a few KB) that is one
+/// cluster of every point.
+fn one_mm(camera: &Camera) -> DepthFrame {
+    let k = &camera.intrinsics;
+    let image = DepthImage::new(k.width, k.height, vec![0.001; k.pixels()]).unwrap();
+    frame_to_msg(&image, camera, depth::DepthEncoding::Png16Mm).unwrap()
+}
+
+/// 2048 × 2048 is over the pixel limit: refused before it is decoded, naming
+/// the limit.
+#[test]
+fn an_image_over_the_pixel_limit_is_refused_naming_it() {
+    use tsukami_vision::camera::MAX_PIXELS;
+    let mut service = VisionService::new(roots(), DetectParams::default(), None);
+    let frame = one_mm(&big_camera(2048, 2048));
+    eprintln!("2048 x 2048 at 1 mm: {} bytes of base64", frame.data.len());
+    let err = service.handle(&request(frame)).unwrap_err();
+    assert_eq!(err.error.code, ErrorCode::InvalidValue);
+    let message = &err.error.message;
+    assert!(
+        message.contains("intrinsics") && message.contains(&MAX_PIXELS.to_string()),
+        "{message}"
+    );
+}
+
+/// The largest image accepted, every pixel at 1 mm (one cluster of all its
+/// 327,680 points): answered, not found, with the work bounded — segments thinned
+/// to `max_segment_points` and no more fits once `max_work` point evaluations are
+/// spent (unbounded it took 33 s). The answer names the budget.
+#[test]
+fn one_cluster_of_every_point_is_bounded_work() {
+    let mut service = VisionService::new(roots(), DetectParams::default(), None);
+    let good = frame_to_msg(&flat(), &camera(), depth::DepthEncoding::F32LeM).unwrap();
+    // The model's template is loaded (once) by a first, small frame.
+    assert!(service.handle(&request(good.clone())).is_err());
+    let frame = one_mm(&big_camera(1280, 1024));
+    let started = std::time::Instant::now();
+    let err = service.handle(&request(frame.clone())).unwrap_err();
+    eprintln!(
+        "1280 x 1024 at 1 mm: {} in {:.2} s",
+        err.error.message,
+        started.elapsed().as_secs_f64()
+    );
+    assert_eq!(err.error.code, ErrorCode::Infeasible, "{err}");
+    assert!(err.error.message.contains("max_work"), "{}", err.error.message);
+    // A budget the cloud alone overruns: nothing is fitted, and the answer says so.
+    let tight = DetectParams {
+        max_work: 1000,
+        ..DetectParams::default()
+    };
+    let mut service = VisionService::new(roots(), tight, None);
+    let err = service.handle(&request(frame)).unwrap_err();
+    assert_eq!(err.error.code, ErrorCode::Infeasible, "{err}");
+    assert!(
+        err.error.message.contains("max_work") && err.error.message.contains("1000"),
+        "{}",
+        err.error.message
+    );
+    // Still serving.
+    let err = service.handle(&request(good)).unwrap_err();
+    assert_eq!(err.error.details.unwrap()["reason"], "not_found");
+}

@@ -179,7 +179,7 @@ fn default_bus() -> BusConfig {
 }
 
 fn default_max_payload() -> usize {
-    16 * 1024 * 1024
+    tsukami_bus::MAX_PAYLOAD_BYTES
 }
 
 /// The config used when `tsukami run` gets no `--config`: the default port and the

@@ -311,25 +311,12 @@ fn watchdog(current: Weak<Mutex<CurrentCall>>, max_call: Duration) {
 }
 
 /// Opens the host's session. With the built-in bus config, zenoh's reassembly
-/// buffer is capped at twice `limits.max_payload_bytes` plus 1 MiB (zenoh's default
-/// is 1 GiB), so an oversized request cannot grow the host before it is refused; a
-/// user's zenoh config sets its own (`transport/link/rx/max_message_size`).
+/// buffer is capped at twice `limits.max_payload_bytes` plus 1 MiB
+/// ([`tsukami_bus::reassembly_cap`], zenoh's default is 1 GiB), so an oversized
+/// request cannot grow the host before it is refused; a user's zenoh config sets
+/// its own (`transport/link/rx/max_message_size`).
 fn open_session(config: &HostConfig) -> Result<zenoh::Session> {
-    if config.bus.zenoh_config.is_some() {
-        return config.bus.open();
-    }
-    let mut zenoh_config = config.bus.to_zenoh()?;
-    let cap = config
-        .limits
-        .max_payload_bytes
-        .saturating_mul(2)
-        .saturating_add(1 << 20);
-    zenoh_config
-        .insert_json5("transport/link/rx/max_message_size", &cap.to_string())
-        .map_err(|e| anyhow::anyhow!("zenoh rx max_message_size: {e}"))?;
-    zenoh::open(zenoh_config)
-        .wait()
-        .map_err(|e| anyhow::anyhow!("opening the zenoh session: {e}"))
+    config.bus.open_bounded(config.limits.max_payload_bytes)
 }
 
 /// The key prefixes this host answers itself: its plugins' roles, and `world`

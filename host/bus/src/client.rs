@@ -161,6 +161,38 @@ impl BusClient {
         Ok(serde_json::from_slice(&bytes)?)
     }
 
+    /// Every component answering `<ns>/*/info` within `timeout`, sorted by name
+    /// (every reply is kept: zenoh's consolidation is off for this query). Error
+    /// replies and replies that are not a component's info (e.g. a host's
+    /// `unknown_command` for a role prefix) are left out.
+    pub fn components(
+        &self,
+        timeout: Duration,
+    ) -> Result<Vec<tsukami_msgs::component::ComponentInfo>, RequestError> {
+        let key = self.keys.component_info_all();
+        let replies = self
+            .session
+            .get(&key)
+            .consolidation(zenoh::query::ConsolidationMode::None)
+            .timeout(timeout)
+            .wait()
+            .map_err(|e| RequestError::Bus {
+                key: key.clone(),
+                message: e.to_string(),
+            })?;
+        let mut found = vec![];
+        while let Ok(reply) = replies.recv() {
+            let Ok(sample) = reply.result() else { continue };
+            if let Ok(info) = serde_json::from_slice::<tsukami_msgs::component::ComponentInfo>(
+                &sample.payload().to_bytes(),
+            ) {
+                found.push(info);
+            }
+        }
+        found.sort_by(|a, b| a.name.cmp(&b.name));
+        Ok(found)
+    }
+
     /// Queries `key` with an empty payload until something answers (an error reply
     /// counts as an answer) or `deadline` passes; returns the first successful reply.
     pub fn wait_for(&self, key: &str, deadline: Duration) -> Result<Vec<u8>, RequestError> {

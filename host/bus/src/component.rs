@@ -7,7 +7,8 @@
 //! publishers so they are listed there).
 //!
 //! Why: the vision and controller processes (and the test mocks) join the bus the
-//! same way as the host — loopback only, no scouting, a zenoh config file replaces
+//! same way as the host — loopback only, no scouting, zenoh's reassembly buffer
+//! capped for the same payload limit as the host's, a zenoh config file replaces
 //! all of it — and a client can see what is on the bus by asking `<ns>/*/info`.
 //!
 //! How: a thin layer over one `zenoh::Session`. Queryables get a plain callback; a
@@ -30,7 +31,7 @@
 //! ```
 
 use crate::config::{default_endpoint, BusConfig, BusMode};
-use crate::serve::{parse_query, reply_error, reply_json};
+use crate::serve::{parse_query, reply_error, reply_json, reply_json_on};
 use anyhow::{anyhow, Result};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
@@ -115,7 +116,9 @@ impl Component {
         description: &str,
         args: &ComponentArgs,
     ) -> Result<Component> {
-        let session = args.bus_config().open()?;
+        let session = args
+            .bus_config()
+            .open_bounded(crate::serve::MAX_PAYLOAD_BYTES)?;
         Component::on_session(session, &args.namespace, name, version, description)
     }
 
@@ -137,11 +140,14 @@ impl Component {
             keys: vec![info_key.clone()],
         }));
         let shared = info.clone();
+        let reply_key = info_key.clone();
         let queryable = session
             .declare_queryable(&info_key)
             .callback(move |query| {
                 let info = shared.lock().unwrap_or_else(|e| e.into_inner()).clone();
-                reply_json(&query, &info);
+                // On its own key: a `<ns>/*/info` query then gets one reply per
+                // component (zenoh consolidates replies on the same key).
+                reply_json_on(&query, &reply_key, &info);
             })
             .wait()
             .map_err(|e| anyhow!("declaring {info_key}: {e}"))?;

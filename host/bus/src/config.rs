@@ -158,6 +158,26 @@ impl BusConfig {
         Ok(config)
     }
 
+    /// Opens a zenoh session with this config, zenoh's reassembly buffer capped
+    /// at [`reassembly_cap`]`(max_payload_bytes)` (zenoh's default is 1 GiB, so one
+    /// oversized request could grow the process by that much before it is
+    /// refused). A user's zenoh config file sets its own
+    /// (`transport/link/rx/max_message_size`) and is used as it is.
+    pub fn open_bounded(&self, max_payload_bytes: usize) -> Result<zenoh::Session> {
+        use zenoh::Wait;
+        if self.zenoh_config.is_some() {
+            return self.open();
+        }
+        let mut config = self.to_zenoh()?;
+        let cap = reassembly_cap(max_payload_bytes);
+        config
+            .insert_json5("transport/link/rx/max_message_size", &cap.to_string())
+            .map_err(|e| anyhow::anyhow!("zenoh rx max_message_size: {e}"))?;
+        zenoh::open(config)
+            .wait()
+            .map_err(|e| anyhow::anyhow!("opening the zenoh session ({}): {e}", self.describe()))
+    }
+
     /// Opens a zenoh session with this config.
     pub fn open(&self) -> Result<zenoh::Session> {
         use zenoh::Wait;
@@ -178,6 +198,15 @@ impl BusConfig {
             ),
         }
     }
+}
+
+/// The largest message zenoh reassembles for a process that accepts payloads of up
+/// to `max_payload_bytes`: twice that plus 1 MiB, so every payload up to twice the
+/// limit is still answered `payload_too_large`; a larger message is dropped by
+/// zenoh's receiving transport (no reply; the link stays up). See
+/// docs/protocol.md, "Payloads over zenoh's reassembly cap".
+pub fn reassembly_cap(max_payload_bytes: usize) -> usize {
+    max_payload_bytes.saturating_mul(2).saturating_add(1 << 20)
 }
 
 /// Refuses endpoints that would leave the machine: the built-in config is loopback

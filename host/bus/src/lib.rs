@@ -25,8 +25,9 @@ pub mod shutdown;
 pub use client::{BusClient, RequestError};
 pub use component::{Component, ComponentArgs};
 pub use config::{
-    check_loopback, default_endpoint, free_loopback_port, BusConfig, BusMode, DEFAULT_PORT,
-    DEFAULT_ROUTER_PORT,
+    check_loopback, default_endpoint, free_loopback_port, reassembly_cap, BusConfig, BusMode,
+    DEFAULT_PORT, DEFAULT_ROUTER_PORT,
 };
+pub use serve::MAX_PAYLOAD_BYTES;
 pub use logging::init_logging;
 pub use shutdown::Shutdown;

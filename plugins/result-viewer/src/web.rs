@@ -12,8 +12,10 @@
 //! reached through an SSH tunnel; no GPU or display is needed on the server.
 //!
 //! How: `std::net` with a thread per connection, at most `max_clients` at
-//! once (more get 503). Reads and writes time out, so a slow or vanished
-//! browser ends only its own thread; nothing here ever holds a lock the bus
+//! once (more get 503). The whole request head has a deadline (5 s from the
+//! connection; then 408), each event must be taken within 5 s, and an event
+//! stream's kernel send buffer is small, so a slow, stalled or vanished browser
+//! ends only its own thread, soon; nothing here ever holds a lock the bus
 //! followers or the plugin's calls wait on while writing. A request whose
 //! `Host` is not a loopback name is refused when bound to loopback (DNS
 //! rebinding).
@@ -27,8 +29,13 @@ use std::time::{Duration, Instant};
 
 use crate::viewer::Viewer;
 
-/// Socket read and write timeout.
+/// Socket read and write timeout; also the whole request head's deadline and
+/// the longest one event may take to write.
 const IO_TIMEOUT: Duration = Duration::from_secs(5);
+/// The kernel's send buffer of an event stream (it doubles it): a page that
+/// stops reading fills it in a few events, and the next write then has
+/// [`IO_TIMEOUT`] to finish (the default buffer grows to megabytes).
+const EVENT_SNDBUF: usize = 16 * 1024;
 /// Largest request head read.
 const MAX_HEAD: usize = 8192;
 /// Shortest time between two events to one page.
@@ -162,8 +169,12 @@ fn connection(
     drop(spawned);
 }
 
-/// Reads the request head (up to the blank line).
+/// Reads the request head (up to the blank line), all of it within
+/// [`IO_TIMEOUT`] of the connection's start: a client trickling a byte at a time
+/// cannot hold its slot longer (the socket timeout alone restarts with every
+/// byte).
 fn read_head(stream: &mut TcpStream) -> io::Result<String> {
+    let deadline = Instant::now() + IO_TIMEOUT;
     let mut head = Vec::with_capacity(1024);
     let mut buf = [0u8; 1024];
     while !head.windows(4).any(|w| w == b"\r\n\r\n") {
@@ -173,6 +184,14 @@ fn read_head(stream: &mut TcpStream) -> io::Result<String> {
                 "request head too large",
             ));
         }
+        let left = deadline.saturating_duration_since(Instant::now());
+        if left.is_zero() {
+            return Err(io::Error::new(
+                io::ErrorKind::TimedOut,
+                "request head not complete in time",
+            ));
+        }
+        stream.set_read_timeout(Some(left))?;
         let n = stream.read(&mut buf)?;
         if n == 0 {
             return Err(io::ErrorKind::UnexpectedEof.into());
@@ -212,7 +231,19 @@ fn serve(
     bound: SocketAddr,
     stop: &AtomicBool,
 ) -> io::Result<()> {
-    let head = read_head(&mut stream)?;
+    let head = match read_head(&mut stream) {
+        Ok(head) => head,
+        Err(e) if matches!(e.kind(), io::ErrorKind::TimedOut | io::ErrorKind::WouldBlock) => {
+            return respond(
+                &mut stream,
+                "408 Request Timeout",
+                "text/plain",
+                b"request head not complete within 5 s\n",
+            );
+        }
+        Err(e) => return Err(e),
+    };
+    let _ = stream.set_read_timeout(Some(IO_TIMEOUT));
     let mut words = head.split_whitespace();
     let (method, target) = (words.next().unwrap_or(""), words.next().unwrap_or(""));
     if method != "GET" {
@@ -257,6 +288,7 @@ fn serve(
 /// The event stream: the state now, then on every change (rate-limited) and
 /// a keep-alive comment when quiet; ends on a failed write or on close.
 fn events(mut stream: TcpStream, viewer: &Viewer, stop: &AtomicBool) -> io::Result<()> {
+    set_send_buffer(&stream, EVENT_SNDBUF);
     stream.write_all(
         b"HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-cache\r\nConnection: keep-alive\r\n\r\n",
     )?;
@@ -264,10 +296,11 @@ fn events(mut stream: TcpStream, viewer: &Viewer, stop: &AtomicBool) -> io::Resu
     let result = (|| loop {
         let seen = viewer.board.generation();
         let state = viewer.state_json();
-        stream.write_all(b"event: state\ndata: ")?;
-        stream.write_all(&state)?;
-        stream.write_all(b"\n\n")?;
-        stream.flush()?;
+        let mut event = Vec::with_capacity(state.len() + 24);
+        event.extend_from_slice(b"event: state\ndata: ");
+        event.extend_from_slice(&state);
+        event.extend_from_slice(b"\n\n");
+        write_by(&mut stream, &event, Instant::now() + IO_TIMEOUT)?;
         viewer.sent();
         let sent_at = Instant::now();
         loop {
@@ -277,11 +310,52 @@ fn events(mut stream: TcpStream, viewer: &Viewer, stop: &AtomicBool) -> io::Resu
             if viewer.board.wait_past(seen, KEEPALIVE).is_some() {
                 break;
             }
-            stream.write_all(b": keep-alive\n\n")?;
-            stream.flush()?;
+            write_by(&mut stream, b": keep-alive\n\n", Instant::now() + IO_TIMEOUT)?;
         }
         std::thread::sleep(MIN_EVENT_INTERVAL.saturating_sub(sent_at.elapsed()));
     })();
     viewer.event_clients.fetch_sub(1, Ordering::Relaxed);
     result
 }
+
+/// Writes all of `bytes` by `deadline` (the socket timeout alone restarts with
+/// every partial write, so a page reading a byte at a time could stretch one
+/// event without end).
+fn write_by(stream: &mut TcpStream, mut bytes: &[u8], deadline: Instant) -> io::Result<()> {
+    while !bytes.is_empty() {
+        let left = deadline.saturating_duration_since(Instant::now());
+        if left.is_zero() {
+            return Err(io::Error::new(io::ErrorKind::TimedOut, "event not taken in time"));
+        }
+        stream.set_write_timeout(Some(left))?;
+        match stream.write(bytes) {
+            Ok(0) => return Err(io::ErrorKind::WriteZero.into()),
+            Ok(n) => bytes = &bytes[n..],
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(())
+}
+
+/// Sets the socket's send buffer (`SO_SNDBUF`); a failure leaves the default
+/// (the write deadline still holds).
+#[cfg(unix)]
+fn set_send_buffer(stream: &TcpStream, bytes: usize) {
+    use std::os::fd::AsRawFd;
+    let value = bytes as libc::c_int;
+    // SAFETY: setsockopt on a socket this thread owns, with a pointer to a live
+    // c_int and its size. A failure (returned, not signalled) keeps the default.
+    let _ = unsafe {
+        libc::setsockopt(
+            stream.as_raw_fd(),
+            libc::SOL_SOCKET,
+            libc::SO_SNDBUF,
+            (&value as *const libc::c_int).cast(),
+            std::mem::size_of::<libc::c_int>() as libc::socklen_t,
+        )
+    };
+}
+
+#[cfg(not(unix))]
+fn set_send_buffer(_: &TcpStream, _: usize) {}

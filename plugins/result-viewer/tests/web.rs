@@ -1,11 +1,14 @@
 //! The viewer's web server on a real loopback socket: the page and its
 //! scripts, the JSON, the event stream following the board, refusals
-//! (method, foreign `Host`, too many connections), and shutdown.
+//! (method, foreign `Host`, too many connections), slow clients (a request head
+//! trickled a byte at a time, an event stream never read) cut at their
+//! deadlines, and shutdown.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::sync::Arc;
-use std::time::Duration;
+use std::sync::atomic::Ordering;
+use std::time::{Duration, Instant};
 
 use tsukami_planner_kit::Session;
 use tsukami_result_viewer::latest::{Board, Outcome};
@@ -135,4 +138,84 @@ fn connections_beyond_the_limit_get_503_and_a_dropped_server_stops_listening() {
         TcpStream::connect(addr).is_err(),
         "nothing listens after the drop"
     );
+}
+
+/// 16 clients trickle a request head a byte a second — each byte well within the
+/// 5 s socket timeout — and so hold all 16 places; each is cut when the head's
+/// 5 s deadline passes, and a normal client is then served the page.
+#[test]
+fn clients_trickling_a_request_head_are_cut_at_its_deadline() {
+    const SLOW: usize = 16;
+    let (server, _viewer) = start(SLOW);
+    let addr = server.addr();
+    let started = Instant::now();
+    let slow: Vec<_> = (0..SLOW)
+        .map(|_| {
+            let reader = connect(addr);
+            let mut writer = reader.try_clone().unwrap();
+            let trickle = std::thread::spawn(move || {
+                for b in b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: 1".iter() {
+                    if writer.write_all(&[*b]).is_err() {
+                        return;
+                    }
+                    std::thread::sleep(Duration::from_secs(1));
+                }
+            });
+            (reader, trickle)
+        })
+        .collect();
+    // Every place is held: a normal client is refused for now.
+    let (status, _) = get(addr, "/");
+    assert!(status.starts_with("HTTP/1.1 503"), "{status}");
+    let mut cut = vec![];
+    for (mut reader, trickle) in slow {
+        let mut answer = Vec::new();
+        match reader.read_to_end(&mut answer) {
+            Ok(_) => assert!(
+                answer.is_empty() || answer.starts_with(b"HTTP/1.1 408"),
+                "{}",
+                String::from_utf8_lossy(&answer)
+            ),
+            Err(e) => assert_eq!(e.kind(), std::io::ErrorKind::ConnectionReset, "{e}"),
+        }
+        cut.push(started.elapsed().as_secs_f64());
+        trickle.join().unwrap();
+    }
+    let last = cut.iter().cloned().fold(0.0, f64::max);
+    eprintln!("slow clients cut after {:.2}–{last:.2} s", cut[0]);
+    assert!(last < 8.0, "the last slow client was cut after {last:.2} s");
+    let (status, page) = get(addr, "/");
+    assert_eq!(status, "HTTP/1.1 200 OK");
+    assert!(!page.is_empty());
+}
+
+/// An event stream whose page never reads is closed once the kernel's buffers
+/// are full and an event has not gone out for 5 s: its place comes back.
+#[test]
+fn an_event_stream_never_read_is_closed() {
+    let (server, viewer) = start(4);
+    let addr = server.addr();
+    let mut s = connect(addr);
+    write!(s, "GET /events HTTP/1.1\r\nHost: {addr}\r\n\r\n").unwrap();
+    let started = Instant::now();
+    let mut k = 0u64;
+    // Changes keep coming (the server sends at most one event per 100 ms);
+    // the stream is never read.
+    while viewer.event_clients.load(Ordering::Relaxed) == 0 && started.elapsed().as_secs() < 10 {
+        std::thread::yield_now();
+    }
+    assert_eq!(viewer.event_clients.load(Ordering::Relaxed), 1);
+    while viewer.event_clients.load(Ordering::Relaxed) > 0 {
+        assert!(started.elapsed().as_secs() < 60, "still open after 60 s");
+        k += 1;
+        let why = format!("infeasible: change {k} {}", "x".repeat(2000));
+        viewer
+            .board
+            .update(|l| l.plan = Some(Arc::new(Outcome::Failed(why))));
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let closed = started.elapsed().as_secs_f64();
+    eprintln!("an unread event stream was closed after {closed:.1} s ({k} changes)");
+    assert!(closed < 30.0, "closed after {closed:.1} s");
+    drop(s);
 }
