@@ -1,6 +1,7 @@
 //! Trajectory-planner messages (`<ns>/motion/plan`).
 
 use crate::common::{JointMap, Pose};
+use crate::planner::ContactReply;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -33,6 +34,13 @@ pub struct MotionPlanRequest {
     /// configured `acceleration`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_acceleration: Option<f64>,
+    /// Accept a grasp planned on another world version by checking it again on
+    /// the current world (no link in the object, an obstacle or the robot
+    /// itself; every contact on the object's surface; force closure with the
+    /// weight) and refusing it when it fails. Default: a grasp of another
+    /// version is refused (`invalid_value`, `details.reason = "world_changed"`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub revalidate: bool,
 }
 
 fn default_lift() -> f64 {
@@ -66,6 +74,17 @@ pub struct MotionGrasp {
     /// grasp type's approach vector turned by the palm pose.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub approach: Option<[f64; 3]>,
+    /// The world version the grasp was planned on (the Plan reply's). A grasp of
+    /// another version than the world's is refused unless the request asks to
+    /// `revalidate` it.
+    pub world_version: u64,
+    /// The finger contacts (the Plan reply's); needed only to `revalidate`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contacts: Vec<ContactReply>,
+    /// Length (m) scaling torques to forces (the Plan reply's), for `revalidate`;
+    /// default: the object's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub characteristic_length: Option<f64>,
 }
 
 /// The grasp type of a [`MotionGrasp`].

@@ -49,6 +49,7 @@ fn times(
             pregrasp_distance: 0.05,
             seed,
             max_samples: 5000,
+            recheck: false,
             acceleration: cfg.acceleration,
         };
         let t = Instant::now();

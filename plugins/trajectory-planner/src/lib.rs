@@ -17,6 +17,8 @@
 //!   velocity limit and an acceleration limit; [`assemble`]: phases into one
 //!   trajectory;
 //! - [`goal`]: the request's start and grasp checked against the robot;
+//!   [`revalidate`]: the grasp's world version, and the grasp checked again on
+//!   the current world when asked;
 //! - [`motion`]: the whole pipeline; [`world`]: the planner kit's world, shared
 //!   with the grasp planners; [`error`]: failures and their codes.
 
@@ -29,6 +31,7 @@ pub mod goal;
 pub mod motion;
 pub mod plugin;
 pub mod resolution;
+pub mod revalidate;
 pub mod rrt_connect;
 pub mod shortcut;
 pub mod timing;

@@ -98,6 +98,9 @@ pub struct MotionQuery<'a> {
     pub max_samples: usize,
     /// Acceleration limit (rad/s², m/s²).
     pub acceleration: f64,
+    /// Check the grasp again on this world first (it was planned on another
+    /// version): [`crate::revalidate::recheck`].
+    pub recheck: bool,
 }
 
 /// A planned motion.
@@ -256,6 +259,9 @@ pub fn plan_motion(
 ) -> Result<Motion, MotionError> {
     let model = &world.robot.model;
     let goal = resolve(world.robot, query.grasp, &query.start, limits)?;
+    if query.recheck {
+        crate::revalidate::recheck(world, query.grasp, &goal)?;
+    }
     let mut joints = goal.reach.clone();
     joints.extend(
         goal.hand

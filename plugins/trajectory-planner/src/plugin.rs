@@ -10,7 +10,8 @@
 //! the grasp, at the same world version.
 //!
 //! How: the request is parsed (`invalid_request` naming the field on a wrong
-//! shape), its values checked (`invalid_value` naming the field), the start
+//! shape), the grasp's world version compared with the snapshot's
+//! ([`crate::revalidate`]), its values checked (`invalid_value` naming the field), the start
 //! completed (the request's joints over the rest posture; no `start`: the
 //! controller's state from `controller/state` if a controller answers within
 //! `controller_timeout_ms`, else the rest posture), then
@@ -34,6 +35,7 @@ use tsukami_plugin_api::{CallContext, CallError, Host, Plugin, PluginInfo};
 
 use crate::error::MotionError;
 use crate::motion::{plan_motion, MotionConfig, MotionQuery, Variant};
+use crate::revalidate::admit;
 use crate::world::SharedWorld;
 
 /// The plugin: the kit's world session and the motion settings.
@@ -170,6 +172,7 @@ impl TrajectoryPlugin {
         let world = snapshot.world().map_err(|e| e.to_call_error())?;
         let version = world.version;
         let fail = |e: MotionError| e.to_call_error(version);
+        let recheck = admit(&req.grasp, version, req.revalidate).map_err(fail)?;
         let acceleration = self.check_values(&req).map_err(fail)?;
         let model = &world.robot.model;
         let (default, source) = self.default_start(model, req.start.is_none());
@@ -182,6 +185,7 @@ impl TrajectoryPlugin {
             seed: req.seed,
             max_samples: req.max_samples as usize,
             acceleration,
+            recheck,
         };
         let cancel = ctx.cancel_flag();
         let host = ctx.host();
