@@ -330,6 +330,18 @@ fn plan_and_recheck(name: &str) {
         reply.planning_ms
     );
     assert!(checks > 1000, "{name}: {checks} re-checks");
+    let c = reply.clearance.as_ref().expect("every paper scene has obstacles");
+    eprintln!(
+        "{name}: nearest an obstacle: {:.1} mm, {} to {} in {} at {:.2} s",
+        c.distance * 1e3,
+        c.link,
+        c.obstacle,
+        c.phase,
+        c.time
+    );
+    assert!(c.distance >= 0.0 && !c.link.is_empty(), "{name}: {c:?}");
+    let named = world.obstacles.iter().any(|o| o.name == c.obstacle);
+    assert!(named, "{name}: {c:?}");
     for used in &grasp.joints_used {
         assert!(t.joint_names.contains(used), "{name}: {used} is moved");
     }
@@ -372,6 +384,24 @@ fn board(name: &str, at: [f64; 3], size: [f64; 3]) -> Obstacle {
             quaternion: [0.0, 0.0, 0.0, 1.0],
         },
     }
+}
+
+/// A safety distance the scene cannot give is refused naming the obstacle in
+/// the way; one out of range is `invalid_value` naming the field.
+#[test]
+fn the_requested_clearance_is_kept_or_the_motion_refused() {
+    let bus = bus();
+    let (grasp, _) = grasp_of(&bus, "can_breast");
+    let wide = json!({ "grasp": grasp, "clearance": { "body": 0.1, "hand": 0.1 } });
+    let e = refusal(motion(&bus.client, &wide));
+    assert_eq!(e.code, ErrorCode::Infeasible, "{}", e.message);
+    assert!(e.message.contains("obstacle `"), "{}", e.message);
+    let bad = json!({ "grasp": grasp, "clearance": { "hand": 0.5 } });
+    let e = refusal(motion(&bus.client, &bad));
+    assert_eq!(e.code, ErrorCode::InvalidValue);
+    assert_eq!(e.details.unwrap()["field"], "clearance.hand");
+    let none = json!({ "grasp": grasp, "clearance": { "body": 0.0, "hand": 0.0 } });
+    motion(&bus.client, &none).expect("no clearance: the default motion's room suffices");
 }
 
 /// Sets the object over the bus; the new world version.
@@ -472,7 +502,8 @@ fn narrow_passage_under_a_shelf_board_is_solved_or_reported() {
 fn refusal(r: Result<MotionPlanReply, RequestError>) -> tsukami_msgs::error::ErrorBody {
     match r {
         Err(RequestError::Reply(e)) => e.error,
-        other => panic!("expected a refusal: {other:?}"),
+        Err(other) => panic!("expected a refusal: {other}"),
+        Ok(m) => panic!("expected a refusal, got a motion (clearance {:?})", m.clearance),
     }
 }
 

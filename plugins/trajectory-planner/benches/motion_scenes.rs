@@ -50,6 +50,7 @@ fn times(
             seed,
             max_samples: 5000,
             recheck: false,
+            clearance: tsukami_trajectory_planner::motion::Clearance::default(),
             acceleration: cfg.acceleration,
         };
         let t = Instant::now();

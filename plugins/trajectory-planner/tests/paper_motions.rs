@@ -21,6 +21,7 @@ fn motion(scene: &str, seed: u64) -> (Motion, MotionGrasp) {
         seed,
         max_samples: 5000,
         recheck: false,
+        clearance: tsukami_trajectory_planner::motion::Clearance::default(),
         acceleration: 2.0,
     };
     let cfg = MotionConfig::default();
@@ -99,6 +100,7 @@ fn progress_in_phase_order_and_stop_cancels() {
         seed: 1,
         max_samples: 5000,
         recheck: false,
+        clearance: tsukami_trajectory_planner::motion::Clearance::default(),
         acceleration: 2.0,
     };
     let cfg = MotionConfig::default();
@@ -144,6 +146,7 @@ fn a_revalidated_grasp_holds_on_its_world_and_fails_once_the_object_moved() {
             seed: 1,
             max_samples: 5000,
             recheck: true,
+            clearance: tsukami_trajectory_planner::motion::Clearance::default(),
             acceleration: 2.0,
         };
         let version = w.version;
