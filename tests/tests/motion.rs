@@ -330,6 +330,18 @@ fn plan_and_recheck(name: &str) {
         reply.planning_ms
     );
     assert!(checks > 1000, "{name}: {checks} re-checks");
+    let c = reply.clearance.as_ref().expect("every paper scene has obstacles");
+    eprintln!(
+        "{name}: nearest an obstacle: {:.1} mm, {} to {} in {} at {:.2} s",
+        c.distance * 1e3,
+        c.link,
+        c.obstacle,
+        c.phase,
+        c.time
+    );
+    assert!(c.distance >= 0.0 && !c.link.is_empty(), "{name}: {c:?}");
+    let named = world.obstacles.iter().any(|o| o.name == c.obstacle);
+    assert!(named, "{name}: {c:?}");
     for used in &grasp.joints_used {
         assert!(t.joint_names.contains(used), "{name}: {used} is moved");
     }
@@ -372,6 +384,39 @@ fn board(name: &str, at: [f64; 3], size: [f64; 3]) -> Obstacle {
             quaternion: [0.0, 0.0, 0.0, 1.0],
         },
     }
+}
+
+/// A safety distance the scene cannot give is refused naming the obstacle in
+/// the way; one out of range is `invalid_value` naming the field.
+#[test]
+fn the_requested_clearance_is_kept_or_the_motion_refused() {
+    let bus = bus();
+    let (grasp, _) = grasp_of(&bus, "can_breast");
+    let wide = json!({ "grasp": grasp, "clearance": { "body": 0.1, "hand": 0.1 } });
+    let e = refusal(motion(&bus.client, &wide));
+    assert_eq!(e.code, ErrorCode::Infeasible, "{}", e.message);
+    assert!(e.message.contains("obstacle `"), "{}", e.message);
+    let bad = json!({ "grasp": grasp, "clearance": { "hand": 0.5 } });
+    let e = refusal(motion(&bus.client, &bad));
+    assert_eq!(e.code, ErrorCode::InvalidValue);
+    assert_eq!(e.details.unwrap()["field"], "clearance.hand");
+    let none = json!({ "grasp": grasp, "clearance": { "body": 0.0, "hand": 0.0 } });
+    motion(&bus.client, &none).expect("no clearance: the default motion's room suffices");
+}
+
+/// Sets the object over the bus; the new world version.
+fn set_object(client: &BusClient, object: &tsukami_msgs::planner::SetObject) -> u64 {
+    let reply = client
+        .command(
+            ROLE_GRASP_PLANNER,
+            planner::SET_OBJECT,
+            &serde_json::to_vec(object).unwrap(),
+            TIMEOUT,
+        )
+        .expect("set_object");
+    serde_json::from_slice::<serde_json::Value>(&reply).unwrap()["world_version"]
+        .as_u64()
+        .unwrap()
 }
 
 fn set_env(client: &BusClient, obstacles: Vec<Obstacle>) {
@@ -453,9 +498,53 @@ fn narrow_passage_under_a_shelf_board_is_solved_or_reported() {
     }
 }
 
-/// A box where the elbow is at the grasp: `infeasible`, naming the link and the box.
+/// The error object of a refused motion request.
+fn refusal(r: Result<MotionPlanReply, RequestError>) -> tsukami_msgs::error::ErrorBody {
+    match r {
+        Err(RequestError::Reply(e)) => e.error,
+        Err(other) => panic!("expected a refusal: {other}"),
+        Ok(m) => panic!("expected a refusal, got a motion (clearance {:?})", m.clearance),
+    }
+}
+
+/// Plan on one world version, move the object (the next version), send the old
+/// grasp: refused, naming both versions. Asked to re-validate it, the motion
+/// planner checks the grasp on the current world and refuses it (the hand would
+/// close beside the can); with the can back in place (another version) the
+/// re-validated grasp holds and the reply names the version it was planned on.
 #[test]
-fn goal_in_collision_is_infeasible_with_the_reason() {
+fn a_grasp_of_another_world_version_is_refused_naming_both() {
+    let bus = bus();
+    let (grasp, _) = grasp_of(&bus, "can_breast");
+    let v = grasp.world_version;
+    let file = models_dir().join("scenes/can_breast.toml");
+    let object = scene_requests(&file).unwrap().object;
+    let mut moved = object.clone();
+    moved.pose.position[1] += 0.03;
+    assert_eq!(set_object(&bus.client, &moved), v + 1);
+    let e = refusal(motion(&bus.client, &json!({ "grasp": grasp })));
+    assert_eq!(e.code, ErrorCode::InvalidValue, "{}", e.message);
+    let d = e.details.clone().unwrap();
+    assert_eq!(d["reason"], "world_changed");
+    assert_eq!(d["field"], "grasp.world_version");
+    assert_eq!((d["grasp_world_version"].as_u64(), d["world_version"].as_u64()), (Some(v), Some(v + 1)));
+    let both = format!("planned on world version {v}, but the world is at version {}", v + 1);
+    assert!(e.message.contains(&both), "{}", e.message);
+    let again = json!({ "grasp": grasp, "revalidate": true, "seed": 1 });
+    let e = refusal(motion(&bus.client, &again));
+    assert_eq!(e.code, ErrorCode::Infeasible, "{}", e.message);
+    assert_eq!(e.details.clone().unwrap()["reason"], "grasp_invalid");
+    let both = format!("planned on world version {v} does not hold on version {}", v + 1);
+    assert!(e.message.contains(&both), "{}", e.message);
+    assert_eq!(set_object(&bus.client, &object), v + 2);
+    let r = motion(&bus.client, &again).expect("the grasp holds with the can back");
+    assert_eq!(r.world_version, v + 2);
+}
+
+/// A box where the elbow is at the grasp, added after the grasp was planned: the
+/// re-validated grasp is `infeasible`, naming the link and the box.
+#[test]
+fn an_obstacle_at_the_elbow_fails_the_revalidation_naming_it() {
     let bus = bus();
     let (grasp, world) = grasp_of(&bus, "can_breast");
     let model = &world.robot.model;
@@ -472,18 +561,15 @@ fn goal_in_collision_is_infeasible_with_the_reason() {
         &bus.client,
         vec![board("post", [at.x, at.y, at.z], [0.06, 0.06, 0.06])],
     );
-    let err = motion(&bus.client, &json!({ "grasp": grasp })).unwrap_err();
-    let RequestError::Reply(e) = err else {
-        panic!("{err}")
-    };
-    assert_eq!(e.error.code, ErrorCode::Infeasible);
+    let e = refusal(motion(&bus.client, &json!({ "grasp": grasp, "revalidate": true })));
+    assert_eq!(e.code, ErrorCode::Infeasible);
     assert_eq!(
-        e.error.details.as_ref().unwrap()["reason"],
-        "goal_in_collision",
+        e.details.as_ref().unwrap()["reason"],
+        "grasp_invalid",
         "{}",
-        e.error.message
+        e.message
     );
-    assert!(e.error.message.contains("`post`"), "{}", e.error.message);
+    assert!(e.message.contains("`post`"), "{}", e.message);
 }
 
 /// Bad grasps: `invalid_value` naming the field; the plugin keeps serving.

@@ -136,3 +136,59 @@ fn a_second_robot_plans_from_its_description_alone() {
     assert_eq!(p["joints_used"], json!([]));
     assert!(p["joint_positions"].get("waist_yaw").is_none());
 }
+
+/// `world_prepare`, `world_commit` and `world_abort` are the host's own
+/// commands to its plugins: a client sending them on any role's keys, with a
+/// made-up version and a moved object, is refused, and nothing changes —
+/// `world/get`, a grasp plan and a motion plan all stay on the world the host
+/// holds.
+#[test]
+fn host_to_plugin_world_commands_are_not_bus_commands() {
+    use tsukami_e2e::{motion_entry, planner_entry, viewer_entry};
+    use tsukami_msgs::host::{WorldChange, WorldPrepare, WorldVersion};
+    use tsukami_msgs::keys::{world as wk, ROLE_RESULT_VIEWER, ROLE_TRAJECTORY_PLANNER};
+    let bus = TestBus::start(test_config(vec![
+        planner_entry(),
+        motion_entry(),
+        viewer_entry(),
+    ]));
+    let c = &bus.client;
+    world(c, "set_robot", r#"{"robot": "tsukami_humanoid"}"#).unwrap();
+    let object = world(c, "set_object", CAN).unwrap();
+    let v = object["world_version"].as_u64().unwrap();
+    let moved = serde_json::from_str(&CAN.replace("0.45", "0.60")).unwrap();
+    let forged = WorldPrepare {
+        version: v + 40,
+        change: WorldChange::SetObject(moved),
+    };
+    let prepare = serde_json::to_vec(&forged).unwrap();
+    let commit = serde_json::to_vec(&WorldVersion { version: v + 40 }).unwrap();
+    for role in [ROLE_GRASP_PLANNER, ROLE_TRAJECTORY_PLANNER, ROLE_RESULT_VIEWER] {
+        for (command, payload) in [
+            (wk::PREPARE, &prepare),
+            (wk::COMMIT, &commit),
+            (wk::ABORT, &commit),
+        ] {
+            let e = c.command(role, command, payload, T).unwrap_err();
+            assert_eq!(
+                e.code(),
+                Some(tsukami_msgs::ErrorCode::UnknownCommand),
+                "{role}/{command}: {e}"
+            );
+            assert!(e.to_string().contains(command), "{role}/{command}: {e}");
+        }
+    }
+    let state = world(c, "get", "{}").unwrap();
+    assert_eq!(state["version"], v);
+    assert_eq!(state["object"]["pose"]["position"], json!([0.45, -0.25, 1.05]));
+    let grasp = plan(c, ROLE_GRASP_PLANNER, r#"{"seed": 1}"#).unwrap();
+    assert_eq!(grasp["world_version"], v);
+    assert_eq!(grasp["object"]["center_of_mass"], object["center_of_mass"]);
+    // The trajectory planner still holds version v: it takes the grasp of v.
+    let request = serde_json::to_vec(&json!({ "grasp": grasp, "seed": 1 })).unwrap();
+    let motion = c
+        .command(ROLE_TRAJECTORY_PLANNER, "plan", &request, T)
+        .unwrap_or_else(|e| panic!("the motion of the grasp of version {v}: {e}"));
+    let motion: Value = serde_json::from_slice(&motion).unwrap();
+    assert_eq!(motion["world_version"], v);
+}

@@ -7,7 +7,9 @@
 //! callback never blocks. Two things are answered by the host itself, in the
 //! callback, so they work while a plugin is busy: `<ns>/<role>/stop` (sets the
 //! running call's cancel flag; the plugin sees it at its next poll) and
-//! `<ns>/host/plugins`.
+//! `<ns>/host/plugins`. The host's own commands to its plugins
+//! (`world_prepare`, `world_commit`, `world_abort`) are refused on every
+//! role's keys: only the world hub calls them.
 //!
 //! Work is bounded: each plugin's queue holds at most `limits.max_queue` requests
 //! (more get `busy`), a queued request keeps only zenoh's own copy of its payload,
@@ -218,6 +220,19 @@ fn call_payload(query: &Query) -> Cow<'_, [u8]> {
         Some(bytes) if !bytes.iter().all(u8::is_ascii_whitespace) => bytes,
         _ => Cow::Borrowed(b"{}"),
     }
+}
+
+/// The refusal of a host-to-plugin command sent on the bus (`unknown_command`,
+/// naming the command and the role): only the host's world hub calls them.
+fn host_only(role: &str, command: &str) -> ErrorReply {
+    ErrorReply::new(
+        ErrorCode::UnknownCommand,
+        format!(
+            "`{command}` is the host's own command to its plugins, not a bus command of role {role}; \
+             change the world with <ns>/world/set_robot, set_object, set_env or remove_env"
+        ),
+    )
+    .with_details(serde_json::json!({ "role": role, "command": command }))
 }
 
 fn lock(current: &Mutex<CurrentCall>) -> std::sync::MutexGuard<'_, CurrentCall> {
@@ -502,6 +517,9 @@ impl RunningHost {
                 };
                 if let Err(error) = check_payload(&query, limits.max_payload_bytes) {
                     return reply_error(&query, error);
+                }
+                if keys::world::HOST_ONLY.contains(&command.as_str()) {
+                    return reply_error(&query, host_only(&role_name, &command));
                 }
                 if command == keys::STOP {
                     let reply = worker.stop();

@@ -279,6 +279,39 @@ fn model_grasp_types_proposes_a_file_that_loads_or_names_what_is_missing() {
 }
 
 #[test]
+fn model_allowed_collisions_proposes_pairs_with_reasons_deterministically() {
+    let robot = repo().join("models/robots/iiwa_allegro").display().to_string();
+    let run = |seed: &str| {
+        let out = tsukami(
+            &["model", "allowed-collisions", &robot, "--samples", "150", "--seed", seed],
+            None,
+        );
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let text = run("4");
+    assert_eq!(text, run("4"), "the same seed gives the same proposal");
+    let table: toml::Table = toml::from_str(&text).unwrap();
+    let pairs = table["allowed_collisions"].as_array().unwrap();
+    assert!(!pairs.is_empty(), "{text}");
+    // Every proposed pair carries its reason; the description's own pair is
+    // not proposed again.
+    for line in text.lines().filter(|l| l.trim_start().starts_with('[')) {
+        assert!(
+            line.contains("# in contact in all 150 postures")
+                || line.contains("# never in contact in 150 postures"),
+            "{line}"
+        );
+    }
+    assert!(!text.contains("[\"palm_link\", \"link_13.0\"]"), "{text}");
+    // The iiwa's base never meets its hand within the joint limits.
+    assert!(text.contains("never in contact"), "{text}");
+    let zero = tsukami(&["model", "allowed-collisions", &robot, "--samples", "0"], None);
+    assert!(!zero.status.success());
+    assert!(String::from_utf8_lossy(&zero.stderr).contains("--samples"));
+}
+
+#[test]
 fn a_reader_that_closes_early_ends_the_client_without_a_panic() {
     use std::os::unix::process::ExitStatusExt;
     use std::process::Stdio;

@@ -23,12 +23,14 @@
 //! [`mesh`], [`mesh_clean`] and [`mesh_io`] (triangle meshes: STL, OBJ,
 //! Collada), [`packages`] (`package://` lookup), [`model`], [`urdf_xml`] and
 //! [`urdf`] (the kinematic tree, lenient or strict), [`kinematics`] (FK, Jacobians), [`ik`],
-//! [`collision`] (with its fast narrow phase [`capsule_mesh`]),
+//! [`collision`] (with its fast narrow phase [`capsule_mesh`]; [`collision_matrix`]
+//! proposes the link pairs a robot description may leave unchecked),
 //! [`shape_spec`], [`object`] and [`scene`] (TOML files).
 
 pub mod capsule_mesh;
 pub mod collada;
 pub mod collision;
+pub mod collision_matrix;
 pub mod compose;
 pub mod convert;
 pub mod error;

@@ -162,3 +162,40 @@ fn rest_pose_is_free_of_self_collision() {
     m.forward_kinematics(&q, &mut fk);
     assert!(c.first_self_collision(&fk, 0.0).is_some());
 }
+
+/// The torso's own links never meet over the whole waist and squat range: the
+/// chest clears the pelvis at full forward pitch (no pair among them is left
+/// unchecked in the robot description, so the model itself must keep them apart).
+#[test]
+fn the_torso_clears_the_pelvis_over_the_waist_and_squat_range() {
+    let m = common::humanoid();
+    let c = RobotCollision::new(&m).unwrap();
+    let mut fk = FkState::new(&m);
+    let torso = ["base_link", "pelvis", "waist_link", "chest", "neck_link", "head_link", "l_arm_stub"];
+    let torso: Vec<usize> = torso.iter().map(|n| m.link_id(n).unwrap()).collect();
+    let steps = |lo: f64, hi: f64| (0..=8).map(move |i| lo + (hi - lo) * f64::from(i) / 8.0);
+    for yaw in steps(-0.8, 0.8) {
+        for pitch in steps(-0.1, 0.75) {
+            for squat in [-0.4, -0.2, 0.0] {
+                for head in [-0.5, 0.9] {
+                    let q = m
+                        .positions_from_named([
+                            ("waist_yaw", yaw),
+                            ("waist_pitch", pitch),
+                            ("squat_z", squat),
+                            ("head_pitch", head),
+                        ])
+                        .unwrap();
+                    m.forward_kinematics(&q, &mut fk);
+                    let hits: Vec<(&str, &str)> = c
+                        .self_collisions(&fk, 0.0)
+                        .into_iter()
+                        .filter(|(a, b)| torso.contains(a) && torso.contains(b))
+                        .map(|(a, b)| (m.links[a].name.as_str(), m.links[b].name.as_str()))
+                        .collect();
+                    assert!(hits.is_empty(), "yaw {yaw}, pitch {pitch}, squat {squat}: {hits:?}");
+                }
+            }
+        }
+    }
+}

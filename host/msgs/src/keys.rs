@@ -44,6 +44,10 @@ pub mod world {
     pub const COMMIT: &str = "world_commit";
     /// Host → plugin: drop the pending change of a version.
     pub const ABORT: &str = "world_abort";
+    /// The host's own commands to its plugins. No bus key reaches them: a query
+    /// `<ns>/<role>/world_prepare` (or `world_commit`, `world_abort`) is refused
+    /// by the host, so no client can change a plugin's world behind the host's.
+    pub const HOST_ONLY: [&str; 3] = [PREPARE, COMMIT, ABORT];
     /// The commands that change the world.
     pub const CHANGES: [&str; 4] = [
         super::planner::SET_ROBOT,

@@ -1,6 +1,7 @@
 //! Trajectory-planner messages (`<ns>/motion/plan`).
 
 use crate::common::{JointMap, Pose};
+use crate::planner::ContactReply;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -33,6 +34,30 @@ pub struct MotionPlanRequest {
     /// configured `acceleration`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_acceleration: Option<f64>,
+    /// Accept a grasp planned on another world version by checking it again on
+    /// the current world (no link in the object, an obstacle or the robot
+    /// itself; every contact on the object's surface; force closure with the
+    /// weight) and refusing it when it fails. Default: a grasp of another
+    /// version is refused (`invalid_value`, `details.reason = "world_changed"`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub revalidate: bool,
+    /// Safety distances from the obstacles; default: the plugin's configured ones
+    /// (10 mm for every link but the hand's, 3 mm for the hand until `close`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearance: Option<ClearanceRequest>,
+}
+
+/// The safety distances of a motion request, metres (0 to 0.1); a missing one
+/// keeps the plugin's.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ClearanceRequest {
+    /// Every link but the hand's, in every phase, from every obstacle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<f64>,
+    /// The hand's links from every obstacle in the reach and the approach.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hand: Option<f64>,
 }
 
 fn default_lift() -> f64 {
@@ -71,6 +96,17 @@ pub struct MotionGrasp {
     /// or empty: the close ends at the grasp posture.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub squeeze: Vec<crate::planner::JointSqueeze>,
+    /// The world version the grasp was planned on (the Plan reply's). A grasp of
+    /// another version than the world's is refused unless the request asks to
+    /// `revalidate` it.
+    pub world_version: u64,
+    /// The finger contacts (the Plan reply's); needed only to `revalidate`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contacts: Vec<ContactReply>,
+    /// Length (m) scaling torques to forces (the Plan reply's), for `revalidate`;
+    /// default: the object's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub characteristic_length: Option<f64>,
 }
 
 /// The grasp type of a [`MotionGrasp`].
@@ -98,6 +134,26 @@ pub struct MotionPlanReply {
     pub planning_ms: f64,
     /// The world version (robot, object, obstacles) the motion was planned on.
     pub world_version: u64,
+    /// The smallest distance from a robot link to an obstacle over the
+    /// trajectory's points, and where; absent when the world has no obstacle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearance: Option<ClearanceReport>,
+}
+
+/// Where a motion comes nearest to the obstacles.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ClearanceReport {
+    /// The distance, metres (at most 1; negative would be an overlap).
+    pub distance: f64,
+    /// The robot link (empty when nothing is within 1 m).
+    pub link: String,
+    /// The obstacle.
+    pub obstacle: String,
+    /// The trajectory phase of the point (`reach`, `approach`, `close`, `lift`).
+    pub phase: String,
+    /// The point's time from the trajectory's start, seconds.
+    pub time: f64,
 }
 
 /// `<ns>/motion/progress`: published while a motion is planned.

@@ -63,8 +63,9 @@ pub struct Hand {
     pub arm_links: Vec<LinkId>,
     /// Links the arm does not move (torso, head, legs) that have geometry.
     pub body_links: Vec<LinkId>,
-    /// Collision shapes; pairs of body links are not checked (they move only
-    /// through the waist and whole-body joints, whose limits are the robot's).
+    /// Collision shapes. Every pair of links is checked for self-collision
+    /// but adjacent ones (a link and its nearest ancestor with geometry, and
+    /// links rigidly attached) and the description's `allowed_collisions`.
     pub collision: RobotCollision,
     /// The fingers.
     pub fingers: Vec<Finger>,
@@ -208,18 +209,13 @@ impl Hand {
             .into_iter()
             .filter(|l| !links.contains(l))
             .collect();
-        let mut collision =
+        let collision =
             RobotCollision::new(model).map_err(|e| KitError::model("robot", e.to_string()))?;
         let body_links: Vec<LinkId> = (0..model.links.len())
             .filter(|l| {
                 !links.contains(l) && !arm_links.contains(l) && !collision.link_parts(*l).is_empty()
             })
             .collect();
-        for (i, &a) in body_links.iter().enumerate() {
-            for &b in &body_links[i + 1..] {
-                collision.allow(a, b);
-            }
-        }
         let fingers = spec
             .fingers
             .iter()

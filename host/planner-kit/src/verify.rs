@@ -19,7 +19,8 @@
 //!
 //! How: checks run in order and the first failure is the reason: the shapes,
 //! then [`geometric_checks`] (no link moved by the grasp more than 1 mm inside
-//! the object or an obstacle, contacts on the surface with agreeing normals:
+//! the object or an obstacle, no two links overlapping but adjacent and
+//! allowed pairs, contacts on the surface with agreeing normals:
 //! [`crate::blocks::grasp_check`], the same rules the paper's planner applies
 //! to its candidates), then the force-closure step.
 
@@ -142,8 +143,9 @@ fn shape_checks<P: GraspPlanner>(world: &World<'_, P>, grasp: &Grasp) -> Result<
 /// Geometric checks of the grasp on the world
 /// ([`crate::blocks::grasp_check`]): the links the grasp moves — the hand, the
 /// arm and everything below the extra (waist, whole-body) joints — no more
-/// than 1 mm into the object or an obstacle, and every contact on the
-/// object's surface with its normal agreeing.
+/// than 1 mm into the object or an obstacle, the robot free of
+/// self-collision, and every contact on the object's surface with its normal
+/// agreeing.
 pub fn geometric_checks<P: GraspPlanner>(
     world: &World<'_, P>,
     grasp: &Grasp,

@@ -28,6 +28,8 @@
 //!   positions, then every robot link against the object and every obstacle:
 //!   penetration deeper than [`Tolerances::penetration`] is a violation (touching
 //!   is allowed; it is how a hand holds);
+//! - **no self-collision**: no two links overlap but adjacent ones and the robot
+//!   description's `allowed_collisions`;
 //! - **the palm where the reply says**, within [`Tolerances::palm_position`] and
 //!   [`Tolerances::palm_angle`];
 //! - **joint limits**, and **`joints_used`** naming every joint beyond the arm and
@@ -200,6 +202,13 @@ pub enum Violation {
         /// Depth (m).
         depth: f64,
     },
+    /// Two links of the robot overlap (neither adjacent nor allowed).
+    SelfCollision {
+        /// One link.
+        link: String,
+        /// The other.
+        other: String,
+    },
     /// The palm is not where the reply says.
     PalmPose {
         /// Position error (m).
@@ -279,6 +288,7 @@ impl fmt::Display for Violation {
             Penetration { link, body, depth } => {
                 write!(f, "link {link} sinks {:.2} mm into {body}", depth * 1e3)
             }
+            SelfCollision { link, other } => write!(f, "link {link} overlaps link {other}"),
             PalmPose { position, angle } => write!(
                 f,
                 "palm pose is {:.2} mm / {:.4} rad from forward kinematics",
@@ -349,6 +359,7 @@ pub fn verify(world: &World, reply: &PlanReply, tol: &Tolerances) -> Verdict {
             v.finger_capability = weakest.as_ref().map(|w| w.0);
             check_penetration(world, &fk, tol, &mut v);
             check_hold(world, reply, &fk, tol, &mut v.violations);
+            check_self_collision(world, &fk, &mut v.violations);
         }
         None => v.violations.push(Violation::BadJoints(
             "posture checks skipped (collision, contacts' links, palm, finger forces)".into(),
@@ -715,6 +726,20 @@ fn recompute_exact(world: &World, reply: &PlanReply) -> Result<f64, String> {
     exact_weight_scale(&grasp, ConeModel::Circular, &weight)
         .map(|w| w.weight_scale)
         .map_err(|e| e.to_string())
+}
+
+fn check_self_collision(world: &World, fk: &FkState, out: &mut Vec<Violation>) {
+    let r = &world.robot;
+    let name = |l: LinkId| r.model.links[l].name.clone();
+    out.extend(
+        r.collision
+            .self_collisions(fk, 0.0)
+            .into_iter()
+            .map(|(a, b)| Violation::SelfCollision {
+                link: name(a),
+                other: name(b),
+            }),
+    );
 }
 
 fn check_penetration(world: &World, fk: &FkState, tol: &Tolerances, v: &mut Verdict) {

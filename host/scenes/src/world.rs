@@ -148,10 +148,18 @@ fn load_robot(models_dir: &Path, req: &SetRobot) -> Result<RobotWorld, WorldErro
     };
     // The robot description beside the URDF names the URDF, the palm and the arm.
     let description = urdf.with_file_name("description.toml");
-    let (urdf_name, palm_name, arm_names) = read_hand_table(&description)?;
+    let (urdf_name, palm_name, arm_names, allowed) = read_hand_table(&description)?;
     let urdf = urdf.with_file_name(urdf_name);
     let model = tsukami_body::urdf::load_urdf(&urdf).map_err(|e| err(field, e))?;
-    let collision = RobotCollision::new(&model).map_err(|e| err(field, e))?;
+    let mut collision = RobotCollision::new(&model).map_err(|e| err(field, e))?;
+    for [a, b] in &allowed {
+        let id = |n: &str| {
+            model
+                .link_id(n)
+                .map_err(|e| err(field, format!("allowed_collisions: {e}")))
+        };
+        collision.allow(id(a)?, id(b)?);
+    }
     let palm = model
         .link_id(&palm_name)
         .map_err(|e| err("set_robot.robot", format!("hand palm_link: {e}")))?;
@@ -175,9 +183,13 @@ fn load_robot(models_dir: &Path, req: &SetRobot) -> Result<RobotWorld, WorldErro
     })
 }
 
-/// `urdf`, and the first `[[hand]]`'s `palm_link` and `arm`, of a robot
-/// description (`description.toml`).
-fn read_hand_table(path: &Path) -> Result<(String, String, Vec<String>), WorldError> {
+/// What the checker reads of a robot description: the URDF, the first hand's
+/// palm link and arm joints, the `allowed_collisions` pairs.
+type HandTable = (String, String, Vec<String>, Vec<[String; 2]>);
+
+/// `urdf`, the first `[[hand]]`'s `palm_link` and `arm`, and the
+/// `allowed_collisions` of a robot description (`description.toml`).
+fn read_hand_table(path: &Path) -> Result<HandTable, WorldError> {
     let field = "set_robot.robot";
     let text = std::fs::read_to_string(path)
         .map_err(|e| err(field, format!("{}: {e}", path.display())))?;
@@ -206,7 +218,20 @@ fn read_hand_table(path: &Path) -> Result<(String, String, Vec<String>), WorldEr
         .and_then(|v| v.as_array())
         .and_then(|a| a.iter().map(|v| v.as_str().map(str::to_owned)).collect())
         .ok_or_else(|| err(field, "hand arm: missing or not a list of names"))?;
-    Ok((urdf.to_owned(), palm.to_owned(), arm))
+    let pair = |v: &toml::Value| -> Option<[String; 2]> {
+        match v.as_array()?.as_slice() {
+            [a, b] => Some([a.as_str()?.to_owned(), b.as_str()?.to_owned()]),
+            _ => None,
+        }
+    };
+    let allowed = match table.get("allowed_collisions") {
+        None => Vec::new(),
+        Some(v) => v
+            .as_array()
+            .and_then(|a| a.iter().map(pair).collect())
+            .ok_or_else(|| err(field, "allowed_collisions: not a list of link-name pairs"))?,
+    };
+    Ok((urdf.to_owned(), palm.to_owned(), arm, allowed))
 }
 
 fn load_object(models_dir: &Path, req: &SetObject) -> Result<ObjectWorld, WorldError> {

@@ -137,9 +137,14 @@ link("base_link", 20.0, [
 joint("squat_z", "prismatic", "base_link", "pelvis", [0, 0, 0.85], axis=(0, 0, 1), limit=(-0.40, 0.0, 2000, 0.3))
 link("pelvis", 8.0, [(("box", [0.20, 0.30, 0.16]), [0, 0, 0], [0, 0, 0])], "dark")
 joint("waist_yaw", "revolute", "pelvis", "waist_link", [0, 0, 0.10], axis=(0, 0, 1), limit=(-0.8, 0.8, 200, 2.0))
-link("waist_link", 2.0, [(("cylinder", 0.08, 0.04), [0, 0, 0], [0, 0, 0])], "dark")
+# The chest box starts 9 cm above the pitch axis so that its front edge clears
+# the pelvis by 1 cm at full forward pitch (0.75 rad): 0.09 cos 0.75 - 0.11 sin
+# 0.75 = -0.009 m, the pelvis top being 0.02 m below the axis. The waist
+# housing (a cylinder that turns with the yaw joint, not the pitch) fills the
+# gap between them.
+link("waist_link", 2.0, [(("cylinder", 0.08, 0.10), [0, 0, 0.03], [0, 0, 0])], "dark")
 joint("waist_pitch", "revolute", "waist_link", "chest", [0, 0, 0], axis=(0, 1, 0), limit=(-0.1, 0.75, 200, 2.0))
-link("chest", 18.0, [(("box", [0.22, 0.30, 0.40]), [0, 0, 0.24], [0, 0, 0])], "grey")
+link("chest", 18.0, [(("box", [0.22, 0.30, 0.35]), [0, 0, 0.265], [0, 0, 0])], "grey")
 
 # ---- head and camera ----
 joint("head_yaw", "revolute", "chest", "neck_link", [0, 0, 0.48], axis=(0, 0, 1), limit=(-1.2, 1.2, 20, 3.0))
@@ -150,8 +155,11 @@ link("head_link", 3.5, [(("sphere", 0.09), [0, 0, 0.06], [0, 0, 0])], "grey")
 joint("camera_joint", "fixed", "head_link", "camera_link", [0.085, 0, 0.07], rpy=(-PI / 2, 0, -PI / 2))
 link("camera_link", 0.0, [])
 
-# ---- left arm: a fixed stub ----
-joint("l_arm_fixed", "fixed", "chest", "l_arm_stub", [0, 0.21, 0.43])
+# ---- left arm: a fixed stub, hanging 0.08 rad out from the body so that it
+# clears the pelvis (by 2 cm) and the thighs over the waist's whole yaw, pitch
+# and squat range; hanging straight down it would sink 15 mm into the pelvis's
+# corner at a waist yaw of 0.6 rad.
+joint("l_arm_fixed", "fixed", "chest", "l_arm_stub", [0, 0.21, 0.43], rpy=(0.08, 0, 0))
 link("l_arm_stub", 5.0, [(("capsule", 0.045, 0.52), [0, 0, -0.305], [0, 0, 0])], "grey")
 
 # ---- right arm, 7 DOF ----

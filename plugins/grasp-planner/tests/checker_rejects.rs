@@ -259,3 +259,27 @@ fn joint_outside_its_limits() {
         |v| matches!(v, Violation::JointLimit { joint, .. } if joint == "r_wrist_pitch"),
     );
 }
+
+#[test]
+fn an_arm_folded_into_the_chest_is_a_self_collision() {
+    let (reply, world, regions) = planned("fridge_pet");
+    accepted("fridge_pet", &world, &reply, regions);
+    let mut folded = reply.clone();
+    for (joint, value) in [
+        ("r_shoulder_roll", 0.25),
+        ("r_shoulder_pitch", -1.3),
+        ("r_elbow", -2.3),
+        ("r_shoulder_yaw", 1.5),
+    ] {
+        folded.joint_positions.insert(joint.into(), value);
+    }
+    rejected(
+        "fridge_pet",
+        &world,
+        &reply,
+        &folded,
+        regions,
+        "an arm folded into the chest",
+        |v| matches!(v, Violation::SelfCollision { .. }),
+    );
+}

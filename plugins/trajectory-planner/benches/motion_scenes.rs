@@ -49,6 +49,8 @@ fn times(
             pregrasp_distance: 0.05,
             seed,
             max_samples: 5000,
+            recheck: false,
+            clearance: tsukami_trajectory_planner::motion::Clearance::default(),
             acceleration: cfg.acceleration,
         };
         let t = Instant::now();

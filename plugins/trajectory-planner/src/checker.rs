@@ -16,7 +16,8 @@
 //! How: a configuration of the planned joints is written into the full joint
 //! vector, mimics are applied, forward kinematics runs once, then
 //! `RobotCollision::first_self_collision` and `first_collision` against the
-//! obstacles with the margin decide. Two optional rules serve the grasp's last
+//! obstacles with the margin decide (each link keeps its clearance from the
+//! obstacles, [`RobotWorld::with_clearance`]). Two optional rules serve the grasp's last
 //! phases: [`ObjectRule`] (the object to grasp, which some hand links may touch
 //! up to a depth while the hand closes on it) and [`Attached`] (the grasped object
 //! moving with the hand, checked against the obstacles and the rest of the robot).
@@ -61,6 +62,10 @@ pub struct RobotWorld<'a> {
     joints: Vec<JointId>,
     base: Vec<f64>,
     margin: f64,
+    /// Per link: the distance it must keep from every obstacle (m).
+    clearance: Vec<f64>,
+    /// The largest of `clearance` (the broad phase's reach).
+    max_clearance: f64,
     sweep: SweepBound,
     max_travel: f64,
     fk: FkState,
@@ -152,6 +157,8 @@ impl<'a> RobotWorld<'a> {
             scratch: base.clone(),
             base,
             margin,
+            clearance: vec![margin; model.links.len()],
+            max_clearance: margin,
             sweep: SweepBound::new(model),
             max_travel: DEFAULT_MAX_TRAVEL,
             fk: FkState::new(model),
@@ -188,6 +195,16 @@ impl<'a> RobotWorld<'a> {
             .filter(|l| !attached.holding.contains(l))
             .collect();
         self.attached = Some(attached);
+        self
+    }
+
+    /// The safety distance from the obstacles: `hand` for the `hand_links`,
+    /// `body` for every other link (m); the self-collision margin is unchanged.
+    pub fn with_clearance(mut self, hand_links: &[LinkId], hand: f64, body: f64) -> Self {
+        for (l, c) in self.clearance.iter_mut().enumerate() {
+            *c = if hand_links.contains(&l) { hand } else { body };
+        }
+        self.max_clearance = hand.max(body);
         self
     }
 
@@ -286,13 +303,14 @@ impl RobotWorld<'_> {
             let links = if first {
                 &self.links
             } else {
-                self.bodies.near(body, self.margin, &mut self.near);
+                self.bodies.near(body, self.max_clearance, &mut self.near);
                 &self.near
             };
-            if let Some(hit) =
+            let hit = links.iter().find_map(|&l| {
                 self.collision
-                    .placed_collision(&self.placement, links, &[*body], self.margin)
-            {
+                    .placed_collision(&self.placement, &[l], &[*body], self.clearance[l])
+            });
+            if let Some(hit) = hit {
                 return Some(Collision {
                     link: name(hit.link),
                     with: format!("obstacle `{}`", body.name),

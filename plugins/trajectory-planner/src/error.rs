@@ -1,6 +1,8 @@
 //! Every way a motion request fails, and its mapping to the wire's error codes.
 //!
-//! What: [`MotionError`] — a bad value (`invalid_value`, naming the field), an
+//! What: [`MotionError`] — a bad value (`invalid_value`, naming the field), a
+//! grasp of another world version (`invalid_value`, reason `world_changed`,
+//! both versions in `details`), an
 //! impossible motion (`infeasible`, with a stable `reason` word and a message
 //! naming the link and the body it hits), a stop (`cancelled`), or the kit's own
 //! errors (`not_ready` before a robot and an object are set).
@@ -36,12 +38,25 @@ pub enum MotionError {
     Infeasible {
         /// Stable machine-readable word: `start_in_collision`, `goal_in_collision`,
         /// `pregrasp_unreachable`, `approach_blocked`, `close_blocked`,
-        /// `lift_unreachable`, `lift_blocked`, `no_path`.
+        /// `lift_unreachable`, `lift_blocked`, `no_path`, `grasp_invalid` (a
+        /// re-validated grasp fails on the current world).
         reason: &'static str,
         /// What happened, naming the link and the body it hits.
         message: String,
         /// Samples the reach planner drew.
         samples: u32,
+    },
+    /// The grasp was planned on another world version and the request did not
+    /// ask to re-validate it.
+    #[error(
+        "the grasp was planned on world version {grasp}, but the world is at version {world}: \
+         plan the grasp again, or set `revalidate` to check it on version {world}"
+    )]
+    WorldChanged {
+        /// The grasp's `world_version`.
+        grasp: u64,
+        /// The current world's version.
+        world: u64,
     },
     /// A `stop` arrived.
     #[error("motion planning cancelled by stop")]
@@ -83,6 +98,14 @@ impl MotionError {
             } => (
                 ErrorCode::Infeasible,
                 serde_json::json!({ "reason": reason, "samples": samples }),
+            ),
+            MotionError::WorldChanged { grasp, .. } => (
+                ErrorCode::InvalidValue,
+                serde_json::json!({
+                    "reason": "world_changed",
+                    "field": "grasp.world_version",
+                    "grasp_world_version": grasp,
+                }),
             ),
             MotionError::Cancelled => (
                 ErrorCode::Cancelled,

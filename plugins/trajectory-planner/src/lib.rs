@@ -17,18 +17,23 @@
 //!   velocity limit and an acceleration limit; [`assemble`]: phases into one
 //!   trajectory;
 //! - [`goal`]: the request's start and grasp checked against the robot;
-//! - [`motion`]: the whole pipeline; [`world`]: the planner kit's world, shared
+//!   [`revalidate`]: the grasp's world version, and the grasp checked again on
+//!   the current world when asked;
+//! - [`motion`]: the whole pipeline (keeping [`motion::Clearance`] from the
+//!   obstacles); [`clearance`]: the smallest distance a motion kept, for the reply; [`world`]: the planner kit's world, shared
 //!   with the grasp planners; [`error`]: failures and their codes.
 
 pub mod assemble;
 pub mod bodies;
 pub mod cartesian;
 pub mod checker;
+pub mod clearance;
 pub mod error;
 pub mod goal;
 pub mod motion;
 pub mod plugin;
 pub mod resolution;
+pub mod revalidate;
 pub mod rrt_connect;
 pub mod shortcut;
 pub mod timing;

@@ -63,6 +63,27 @@ pub struct MotionConfig {
     pub line_step: f64,
     /// How far the carried object rises before its supports are checked (m).
     pub support_clearance: f64,
+    /// Safety distances from the obstacles when a request gives none.
+    pub clearance: Clearance,
+}
+
+/// Safety distances every motion keeps from the obstacles (m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Clearance {
+    /// Every link but the hand's, in every phase.
+    pub body: f64,
+    /// The hand's links in the reach and the approach (from `close` on, the hand
+    /// may touch what the object rests on).
+    pub hand: f64,
+}
+
+impl Default for Clearance {
+    fn default() -> Self {
+        Clearance {
+            body: 0.010,
+            hand: 0.003,
+        }
+    }
 }
 
 impl Default for MotionConfig {
@@ -77,6 +98,7 @@ impl Default for MotionConfig {
             rrt_step: 0.15,
             line_step: 0.005,
             support_clearance: 0.002,
+            clearance: Clearance::default(),
         }
     }
 }
@@ -98,6 +120,11 @@ pub struct MotionQuery<'a> {
     pub max_samples: usize,
     /// Acceleration limit (rad/s², m/s²).
     pub acceleration: f64,
+    /// Check the grasp again on this world first (it was planned on another
+    /// version): [`crate::revalidate::recheck`].
+    pub recheck: bool,
+    /// Safety distances from the obstacles.
+    pub clearance: Clearance,
 }
 
 /// A planned motion.
@@ -156,15 +183,19 @@ struct Scene<'a> {
     joints: Vec<JointId>,
     env: Vec<&'a CollisionObject>,
     cfg: &'a MotionConfig,
+    clearance: Clearance,
     checks: usize,
 }
 
 impl<'a> Scene<'a> {
+    /// The robot among `obstacles`, the hand keeping `hand_clearance` from
+    /// them, every other link the body clearance.
     fn robot_world(
         &self,
         obstacles: Vec<&'a CollisionObject>,
         joints: Vec<JointId>,
         base: &[f64],
+        hand_clearance: f64,
     ) -> RobotWorld<'a> {
         let hand = self.world.robot.hand();
         RobotWorld::new(
@@ -176,19 +207,21 @@ impl<'a> Scene<'a> {
             0.0,
         )
         .with_max_travel(self.cfg.max_travel)
+        .with_clearance(&hand.links, hand_clearance, self.clearance.body)
     }
 
-    /// Every link clear of the obstacles and the object.
+    /// Every link clear of the obstacles and the object, by the clearances.
     fn free(&self, joints: Vec<JointId>, base: &[f64]) -> RobotWorld<'a> {
         let mut all = self.env.clone();
         all.push(&self.world.object.collision);
-        self.robot_world(all, joints, base)
+        self.robot_world(all, joints, base, self.clearance.hand)
     }
 
-    /// Hand links may touch the object.
-    fn touching(&self, base: &[f64]) -> RobotWorld<'a> {
+    /// Hand links may touch the object; the hand keeps `hand_clearance` from
+    /// the obstacles (the approach: the hand's; closing: none).
+    fn touching(&self, base: &[f64], hand_clearance: f64) -> RobotWorld<'a> {
         let hand = self.world.robot.hand();
-        self.robot_world(self.env.clone(), self.joints.clone(), base)
+        self.robot_world(self.env.clone(), self.joints.clone(), base, hand_clearance)
             .with_object(ObjectRule {
                 body: &self.world.object.collision,
                 touching: hand.links.clone(),
@@ -224,7 +257,7 @@ impl<'a> Scene<'a> {
             origin: object.pose.translation.vector,
             clearance: self.cfg.support_clearance,
         };
-        self.robot_world(self.env.clone(), self.joints.clone(), &self.goal.closed)
+        self.robot_world(self.env.clone(), self.joints.clone(), &self.goal.closed, 0.0)
             .with_attached(attached)
     }
 
@@ -243,6 +276,20 @@ fn infeasible(reason: &'static str, what: &str, c: &Collision) -> MotionError {
     MotionError::infeasible(reason, format!("{what}: {c}"))
 }
 
+/// The query's goal on `world`, checked again on it first when the query asks
+/// ([`crate::revalidate::recheck`]).
+fn goal_of(
+    world: &World<'_, SharedWorld>,
+    query: &MotionQuery<'_>,
+    limits: &Limits,
+) -> Result<Goal, MotionError> {
+    let goal = resolve(world.robot, query.grasp, &query.start, limits)?;
+    if query.recheck {
+        crate::revalidate::recheck(world, query.grasp, &goal)?;
+    }
+    Ok(goal)
+}
+
 /// Plans the motion of `query` in `world`. `cancelled` is polled once per reach
 /// sample; `progress` hears each phase as it starts, with the samples drawn.
 pub fn plan_motion(
@@ -255,7 +302,7 @@ pub fn plan_motion(
     progress: &mut dyn FnMut(&str, usize),
 ) -> Result<Motion, MotionError> {
     let model = &world.robot.model;
-    let goal = resolve(world.robot, query.grasp, &query.start, limits)?;
+    let goal = goal_of(world, query, limits)?;
     let mut joints = goal.reach.clone();
     joints.extend(
         goal.hand
@@ -270,12 +317,13 @@ pub fn plan_motion(
         joints,
         env: world.obstacles.clone(),
         cfg,
+        clearance: query.clearance,
         checks: 0,
     };
     let w = s.free(s.joints.clone(), &query.start);
     s.check(w, &[s.p(&query.start)])
         .map_err(|c| infeasible("start_in_collision", "the start posture collides", &c))?;
-    let w = s.touching(&s.goal.closed);
+    let w = s.touching(&s.goal.closed, 0.0);
     s.check(w, &[s.p(&s.goal.closed)])
         .map_err(|c| infeasible("goal_in_collision", "the grasp posture collides", &c))?;
     progress("approach", 0);
@@ -301,7 +349,7 @@ pub fn plan_motion(
     let mut reach_phase = vec![opening[0].clone()];
     reach_phase.extend(reach.iter().map(|q| s.p(q)));
     progress("close", samples);
-    let w = s.touching(&s.goal.open);
+    let w = s.touching(&s.goal.open, 0.0);
     s.check(w, &[open.clone(), closed.clone()])
         .map_err(|c| infeasible("close_blocked", "closing the hand collides", &c))?;
     progress("lift", samples);
@@ -362,7 +410,7 @@ fn open_and_approach(s: &mut Scene<'_>, distance: f64) -> Result<Vec<Vec<f64>>, 
     let mut first = None;
     for opening in OPENINGS {
         s.goal.open_by(s.model, opening);
-        let w = s.touching(&s.goal.open);
+        let w = s.touching(&s.goal.open, s.clearance.hand);
         let tried = s
             .check(w, &[s.p(&s.goal.open)])
             .map_err(|c| {
@@ -401,7 +449,7 @@ fn approach_path(s: &mut Scene<'_>, distance: f64) -> Result<Vec<Vec<f64>>, Moti
     path.reverse();
     path.push(s.goal.open.clone());
     let projected: Vec<Vec<f64>> = path.iter().map(|q| s.p(q)).collect();
-    let w = s.touching(&s.goal.open);
+    let w = s.touching(&s.goal.open, s.clearance.hand);
     s.check(w, &projected).map_err(|c| {
         infeasible(
             "approach_blocked",

@@ -10,7 +10,8 @@
 //! the grasp, at the same world version.
 //!
 //! How: the request is parsed (`invalid_request` naming the field on a wrong
-//! shape), its values checked (`invalid_value` naming the field), the start
+//! shape), the grasp's world version compared with the snapshot's
+//! ([`crate::revalidate`]), its values checked (`invalid_value` naming the field), the start
 //! completed (the request's joints over the rest posture; no `start`: the
 //! controller's state from `controller/state` if a controller answers within
 //! `controller_timeout_ms`, else the rest posture), then
@@ -20,7 +21,8 @@
 //!
 //! Config keys (beside the kit's `model_roots`, `limits`, `max_samples`):
 //! `acceleration`, `default_velocity`, `sample_dt`, `max_travel`,
-//! `touch_tolerance`, `shortcut_attempts`, `controller_timeout_ms`.
+//! `touch_tolerance`, `shortcut_attempts`, `controller_timeout_ms`,
+//! `clearance_body`, `clearance_hand` (m; a request's `clearance` overrides them).
 
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
@@ -33,7 +35,8 @@ use tsukami_planner_kit::{PlannerConfig, Session};
 use tsukami_plugin_api::{CallContext, CallError, Host, Plugin, PluginInfo};
 
 use crate::error::MotionError;
-use crate::motion::{plan_motion, MotionConfig, MotionQuery, Variant};
+use crate::motion::{plan_motion, Clearance, MotionConfig, MotionQuery, Variant};
+use crate::revalidate::admit;
 use crate::world::SharedWorld;
 
 /// The plugin: the kit's world session and the motion settings.
@@ -77,6 +80,10 @@ pub fn motion_config(table: &toml::Table) -> Result<(MotionConfig, Duration), St
         sample_dt: number(&mut t, "sample_dt", d.sample_dt, (1e-3, 1.0))?,
         max_travel: number(&mut t, "max_travel", d.max_travel, (1e-4, 0.005))?,
         touch_tolerance: number(&mut t, "touch_tolerance", d.touch_tolerance, (0.0, 0.005))?,
+        clearance: Clearance {
+            body: number(&mut t, "clearance_body", d.clearance.body, (0.0, 0.1))?,
+            hand: number(&mut t, "clearance_hand", d.clearance.hand, (0.0, 0.1))?,
+        },
         shortcut_attempts: number(
             &mut t,
             "shortcut_attempts",
@@ -152,6 +159,23 @@ impl TrajectoryPlugin {
         Ok(a)
     }
 
+    /// The request's clearances over the configured ones, each 0 to 0.1 m.
+    fn clearance(&self, req: &MotionPlanRequest) -> Result<Clearance, MotionError> {
+        let d = self.motion.clearance;
+        let Some(c) = &req.clearance else {
+            return Ok(d);
+        };
+        let pick = |v: Option<f64>, default: f64, field: &str| match v {
+            None => Ok(default),
+            Some(x) if x.is_finite() && (0.0..=0.1).contains(&x) => Ok(x),
+            Some(_) => Err(MotionError::invalid(field, "must be 0 to 0.1 m")),
+        };
+        Ok(Clearance {
+            body: pick(c.body, d.body, "clearance.body")?,
+            hand: pick(c.hand, d.hand, "clearance.hand")?,
+        })
+    }
+
     fn plan(&self, payload: &[u8], ctx: &CallContext<'_>) -> Result<Vec<u8>, CallError> {
         let t0 = Instant::now();
         let payload: &[u8] = if payload.iter().all(u8::is_ascii_whitespace) {
@@ -170,6 +194,7 @@ impl TrajectoryPlugin {
         let world = snapshot.world().map_err(|e| e.to_call_error())?;
         let version = world.version;
         let fail = |e: MotionError| e.to_call_error(version);
+        let recheck = admit(&req.grasp, version, req.revalidate).map_err(fail)?;
         let acceleration = self.check_values(&req).map_err(fail)?;
         let model = &world.robot.model;
         let (default, source) = self.default_start(model, req.start.is_none());
@@ -182,6 +207,8 @@ impl TrajectoryPlugin {
             seed: req.seed,
             max_samples: req.max_samples as usize,
             acceleration,
+            recheck,
+            clearance: self.clearance(&req).map_err(fail)?,
         };
         let cancel = ctx.cancel_flag();
         let host = ctx.host();
@@ -206,6 +233,7 @@ impl TrajectoryPlugin {
             &mut progress,
         )
         .map_err(fail)?;
+        let clearance = crate::clearance::smallest(&world, &motion.trajectory, &query.start);
         let reply = MotionPlanReply {
             trajectory: motion.trajectory,
             start_source: if req.start.is_some() {
@@ -217,6 +245,7 @@ impl TrajectoryPlugin {
             checks: motion.checks as u64,
             planning_ms: t0.elapsed().as_secs_f64() * 1e3,
             world_version: version,
+            clearance,
         };
         serde_json::to_vec(&reply).map_err(|e| CallError::new("internal", e.to_string()))
     }

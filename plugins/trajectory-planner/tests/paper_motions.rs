@@ -20,6 +20,8 @@ fn motion(scene: &str, seed: u64) -> (Motion, MotionGrasp) {
         pregrasp_distance: 0.05,
         seed,
         max_samples: 5000,
+        recheck: false,
+        clearance: tsukami_trajectory_planner::motion::Clearance::default(),
         acceleration: 2.0,
     };
     let cfg = MotionConfig::default();
@@ -97,6 +99,8 @@ fn progress_in_phase_order_and_stop_cancels() {
         pregrasp_distance: 0.05,
         seed: 1,
         max_samples: 5000,
+        recheck: false,
+        clearance: tsukami_trajectory_planner::motion::Clearance::default(),
         acceleration: 2.0,
     };
     let cfg = MotionConfig::default();
@@ -122,4 +126,57 @@ fn progress_in_phase_order_and_stop_cancels() {
         cancelled,
         Err(tsukami_trajectory_planner::error::MotionError::Cancelled)
     );
+}
+
+/// A grasp re-validated on the world it was planned on passes; once the object
+/// has moved 3 cm, the same grasp fails the re-check (`grasp_invalid`, naming
+/// both versions and what fails) instead of closing the hand on air.
+#[test]
+fn a_revalidated_grasp_holds_on_its_world_and_fails_once_the_object_moved() {
+    use tsukami_trajectory_planner::error::MotionError;
+    let (world, grasp) = common::grasps::scene("can_breast", 0);
+    let plan = |world: &tsukami_planner_kit::Session<_>| {
+        let snapshot = world.snapshot();
+        let w = snapshot.world().unwrap();
+        let query = MotionQuery {
+            grasp: &grasp,
+            start: w.robot.model.rest_positions(),
+            lift_height: 0.05,
+            pregrasp_distance: 0.05,
+            seed: 1,
+            max_samples: 5000,
+            recheck: true,
+            clearance: tsukami_trajectory_planner::motion::Clearance::default(),
+            acceleration: 2.0,
+        };
+        let version = w.version;
+        let out = plan_motion(
+            &w,
+            &query,
+            &MotionConfig::default(),
+            &Limits::default(),
+            Variant::default(),
+            &|| false,
+            &mut |_, _| {},
+        );
+        (out, version)
+    };
+    let (same, _) = plan(&world);
+    same.expect("the grasp holds on the world it was planned on");
+    let scene = common::grasps::models().join("scenes/can_breast.toml");
+    let mut object = tsukami_scenes::scene_requests(&scene).unwrap().object;
+    object.pose.position[1] += 0.03;
+    world.set_object(&object).unwrap();
+    let (moved, version) = plan(&world);
+    match moved {
+        Err(MotionError::Infeasible { reason, message, .. }) => {
+            assert_eq!(reason, "grasp_invalid");
+            let versions = format!(
+                "planned on world version {} does not hold on version {version}",
+                grasp.world_version
+            );
+            assert!(message.contains(&versions), "{message}");
+        }
+        other => panic!("a moved object must fail the re-check: {other:?}"),
+    }
 }

@@ -1,5 +1,6 @@
-//! `tsukami model inspect|fk|ik|compose|grasp-types`: the body library (and the
-//! planner kit's grasp-type derivation) on the command line.
+//! `tsukami model inspect|fk|ik|compose|grasp-types|allowed-collisions`: the
+//! body library (and the planner kit's grasp-type derivation) on the command
+//! line.
 //!
 //! Output field names are a contract external tools rely on (see
 //! [`super::model_report`], which defines them); `--batch FILE` runs thousands of
@@ -66,6 +67,22 @@ pub enum ModelCommand {
         /// Where to write the file (default: standard output).
         #[arg(long, short)]
         out: Option<PathBuf>,
+        #[command(flatten)]
+        load: LoadArgs,
+    },
+    /// Proposes a robot description's `allowed_collisions` from random
+    /// postures: link pairs in contact in every posture or in none (as MoveIt's
+    /// setup assistant does), printed as TOML with the reason per pair.
+    AllowedCollisions {
+        /// The robot's folder (holding `description.toml`) or its description file;
+        /// pairs it already allows are not proposed again.
+        robot: PathBuf,
+        /// Random postures to sample.
+        #[arg(long, default_value_t = 2000)]
+        samples: usize,
+        /// Seed of the postures (same seed, same proposal).
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
         #[command(flatten)]
         load: LoadArgs,
     },
@@ -274,13 +291,11 @@ fn compose(c: &ComposeArgs) -> Result<()> {
     Ok(())
 }
 
-/// `tsukami model grasp-types`: the robot description and URDF read as
-/// `inspect` reads them, the first hand resolved, its grasp types derived
-/// (`tsukami_planner_kit::grasp_derive`), checked against the model and written.
-fn grasp_types(robot: &Path, out: Option<&Path>, args: &LoadArgs) -> Result<()> {
+/// The description file of a robot folder or file, parsed, and its URDF's path.
+fn read_description(
+    robot: &Path,
+) -> Result<(tsukami_planner_kit::description::Description, PathBuf)> {
     use tsukami_planner_kit::description::{Description, FILE_NAME};
-    use tsukami_planner_kit::grasp_derive::{derive, to_toml, DeriveOptions};
-    use tsukami_planner_kit::grasp_types::GraspTypeConfig;
     let file = if robot.is_dir() {
         robot.join(FILE_NAME)
     } else {
@@ -293,6 +308,55 @@ fn grasp_types(robot: &Path, out: Option<&Path>, args: &LoadArgs) -> Result<()> 
         .parent()
         .unwrap_or(Path::new("."))
         .join(&description.urdf);
+    Ok((description, urdf))
+}
+
+/// `tsukami model allowed-collisions`: the robot's collision shapes with its
+/// adjacent and already allowed pairs, then
+/// `tsukami_body::collision_matrix::propose_allowed` over random postures.
+fn allowed_collisions(robot: &Path, samples: usize, seed: u64, args: &LoadArgs) -> Result<()> {
+    use tsukami_body::collision_matrix::{propose_allowed, to_toml};
+    anyhow::ensure!(samples > 0, "--samples must be at least 1");
+    let (description, urdf) = read_description(robot)?;
+    let options = tsukami_body::urdf::LoadOptions {
+        strict: args.strict,
+        packages: tsukami_body::packages::PackagePath::default()
+            .with_env()
+            .with_dirs(args.package_dirs.iter().cloned()),
+        ..Default::default()
+    };
+    let model = tsukami_body::urdf::load_urdf_with(&urdf, &options)?.model;
+    let mut collision = tsukami_body::collision::RobotCollision::new(&model)?;
+    for (k, [a, b]) in description.allowed_collisions.iter().enumerate() {
+        let id = |n: &str| {
+            model
+                .link_id(n)
+                .with_context(|| format!("allowed_collisions[{k}]: link `{n}` is not in the URDF"))
+        };
+        collision.allow(id(a)?, id(b)?);
+    }
+    let proposal = propose_allowed(&model, &collision, samples, seed);
+    println!(
+        "# tsukami model allowed-collisions {} --samples {samples} --seed {seed}",
+        robot.display()
+    );
+    print!("{}", to_toml(&model, &proposal));
+    eprintln!(
+        "{} pairs proposed, {} kept checked ({} already allowed in the description)",
+        proposal.pairs.len(),
+        proposal.sometimes.len(),
+        description.allowed_collisions.len()
+    );
+    Ok(())
+}
+
+/// `tsukami model grasp-types`: the robot description and URDF read as
+/// `inspect` reads them, the first hand resolved, its grasp types derived
+/// (`tsukami_planner_kit::grasp_derive`), checked against the model and written.
+fn grasp_types(robot: &Path, out: Option<&Path>, args: &LoadArgs) -> Result<()> {
+    use tsukami_planner_kit::grasp_derive::{derive, to_toml, DeriveOptions};
+    use tsukami_planner_kit::grasp_types::GraspTypeConfig;
+    let (description, urdf) = read_description(robot)?;
     let model = load(&urdf, args)?;
     let spec = &description.hands[0];
     let empty = GraspTypeConfig {
@@ -336,6 +400,12 @@ fn grasp_types(robot: &Path, out: Option<&Path>, args: &LoadArgs) -> Result<()> 
 pub fn run(command: &ModelCommand) -> Result<()> {
     match command {
         ModelCommand::Compose(c) => compose(c),
+        ModelCommand::AllowedCollisions {
+            robot,
+            samples,
+            seed,
+            load: args,
+        } => allowed_collisions(robot, *samples, *seed, args),
         ModelCommand::GraspTypes {
             robot,
             out,

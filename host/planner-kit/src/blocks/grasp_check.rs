@@ -10,7 +10,9 @@
 //!   its link within [`CONTACT_GAP`] of it, and its normal within
 //!   [`NORMAL_TOLERANCE`] of the surface's normal cone there (the triangle's
 //!   normal inside a face; the cone of the faces meeting at an edge or a
-//!   vertex, as the independent checker has it).
+//!   vertex, as the independent checker has it);
+//! - no two links of the robot overlap, but the pairs its collision shapes
+//!   allow (adjacent links and the description's `allowed_collisions`).
 //!
 //! A failure names the link and what it hit ([`Rejection`]).
 //!
@@ -79,6 +81,13 @@ pub enum Rejection {
         /// Depth (m).
         depth: f64,
     },
+    /// Two links of the robot overlap (a pair not allowed to).
+    SelfCollision {
+        /// One link.
+        link: LinkId,
+        /// The other.
+        other: LinkId,
+    },
     /// A contact is off the surface, its link away from it, or its normal
     /// disagrees with the surface's.
     Contact {
@@ -96,6 +105,9 @@ impl Rejection {
             Rejection::Penetration { link, into, .. } => {
                 format!("{} into {into}", model.links[*link].name)
             }
+            Rejection::SelfCollision { link, other } => {
+                format!("{} vs {}", model.links[*link].name, model.links[*other].name)
+            }
             Rejection::Contact { link, .. } => {
                 format!("contact of {} off the surface", model.links[*link].name)
             }
@@ -110,6 +122,10 @@ impl Rejection {
                 model.links[*link].name,
                 depth * 1e3,
                 PENETRATION_TOLERANCE * 1e3
+            ),
+            Rejection::SelfCollision { link, other } => format!(
+                "link `{}` overlaps link `{}` (neither adjacent nor in `allowed_collisions`)",
+                model.links[*link].name, model.links[*other].name
             ),
             Rejection::Contact { link, detail } => {
                 format!(
@@ -135,7 +151,8 @@ pub fn check_in<P: crate::planner::GraspPlanner>(
 }
 
 /// Checks the grasp at the posture in `fk` (see the module docs): `links`
-/// against the object and `env`, then every contact.
+/// against the object and `env`, the whole robot against itself, then every
+/// contact.
 pub fn check_grasp(
     col: &RobotCollision,
     fk: &FkState,
@@ -152,6 +169,9 @@ pub fn check_grasp(
             into: everything[p.object].name.clone(),
             depth: p.depth,
         });
+    }
+    if let Some((link, other)) = col.first_self_collision(fk, 0.0) {
+        return Err(Rejection::SelfCollision { link, other });
     }
     for c in contacts {
         check_contact(col, fk, object, c)?;
