@@ -7,8 +7,9 @@
 //! world with the planner kit's verification of every grasp
 //! ([`tsukami_planner_kit::verify::verify`]): no link more than 1 mm into the
 //! object or an obstacle, no self-collision, every contact on the object's
-//! surface next to its link with its normal agreeing, and force closure with
-//! the object's weight. A grasp that fails is `infeasible`
+//! surface next to its link with its normal agreeing, and the default hold
+//! test (force closure, the disturbance set within the joints' torques, the
+//! style's rule: docs/force-closure.md). A grasp that fails is `infeasible`
 //! (`grasp_invalid`) with the check's reason.
 //!
 //! Why: the world changes between a grasp plan and its motion (the object
@@ -113,7 +114,9 @@ pub fn recheck(
         contacts: contacts(world, grasp)?,
         characteristic_length: grasp.characteristic_length,
     };
-    tsukami_planner_kit::verify::verify(world, &kit_grasp)
+    // The default hold test: a re-validated grasp must hold as a new one would.
+    let hold = tsukami_msgs::planner::HoldRequest::default();
+    tsukami_planner_kit::verify::verify(world, &kit_grasp, &hold)
         .map(|_| ())
         .map_err(|why| {
             MotionError::infeasible(
