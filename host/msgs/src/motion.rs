@@ -91,11 +91,6 @@ pub struct MotionGrasp {
     /// grasp type's approach vector turned by the palm pose.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub approach: Option<[f64; 3]>,
-    /// The squeeze of the Plan reply: the `close` phase ends at each listed
-    /// hand joint's `target` (beyond contact) and the lift keeps it; absent
-    /// or empty: the close ends at the grasp posture.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub squeeze: Vec<crate::planner::JointSqueeze>,
     /// The world version the grasp was planned on (the Plan reply's). A grasp of
     /// another version than the world's is refused unless the request asks to
     /// `revalidate` it.

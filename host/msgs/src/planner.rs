@@ -632,8 +632,8 @@ pub struct JointSqueeze {
     /// Servo stiffness (N·m/rad) the target assumes: the joint's effort over
     /// the hand's `servo_saturation`.
     pub stiffness: f64,
-    /// Target of a position-controlled hand: `position + torque / stiffness`,
-    /// clamped to the joint's limits; the trajectory's `close` phase ends here.
+    /// Target of a position-controlled hand: `position` + the motion that closes the contacts' gaps + `torque / stiffness`,
+    /// clamped to the joint's limits (what a hand controller commands after `close`).
     pub target: f64,
 }
 

@@ -48,9 +48,6 @@ pub struct Goal {
     pub hand: Vec<JointId>,
     /// The grasp posture, hand closed (full joint vector).
     pub closed: Vec<f64>,
-    /// The grasp posture with the hand joints at their squeeze targets (the
-    /// servo command that makes the fingers press; `closed` without a squeeze).
-    pub squeezed: Vec<f64>,
     /// The grasp posture, hand open (see [`Goal::open_by`]).
     pub open: Vec<f64>,
     /// The joints that open the hand and their fully open values: the
@@ -218,35 +215,6 @@ fn approach_direction(
     Ok(palm.rotation * g.approach())
 }
 
-/// `closed` with the grasp's squeeze targets on the hand joints it lists
-/// (mimic joints follow): each must be an independent hand joint, its target
-/// finite and within the joint's limits.
-fn squeezed(robot: &Robot, grasp: &MotionGrasp, closed: &[f64]) -> Result<Vec<f64>, MotionError> {
-    let (model, hand) = (&robot.model, robot.hand());
-    let mut out = closed.to_vec();
-    for (i, s) in grasp.squeeze.iter().enumerate() {
-        let field = format!("grasp.squeeze[{i}]");
-        let j = model
-            .joint_id(&s.joint)
-            .ok()
-            .filter(|j| hand.joints.contains(j))
-            .ok_or_else(|| {
-                MotionError::invalid(&field, format!("`{}` is not a joint of the hand", s.joint))
-            })?;
-        let lim = model.joints[j].limits;
-        if !(s.target.is_finite() && s.target >= lim.lower - 1e-9 && s.target <= lim.upper + 1e-9)
-        {
-            return Err(MotionError::invalid(
-                format!("{field}.target"),
-                format!("{} is outside the joint's limits [{}, {}]", s.target, lim.lower, lim.upper),
-            ));
-        }
-        out[j] = s.target.clamp(lim.lower, lim.upper);
-    }
-    model.apply_mimics(&mut out);
-    Ok(out)
-}
-
 /// Resolves `grasp` from the full `start` configuration.
 pub fn resolve(
     robot: &Robot,
@@ -283,9 +251,7 @@ pub fn resolve(
         ));
     }
     let reach = reach_joints(robot, grasp, &set, start, &closed)?;
-    let squeezed = squeezed(robot, grasp, &closed)?;
     let mut goal = Goal {
-        squeezed,
         approach: approach_direction(robot, grasp, &palm)?,
         reach,
         hand: hand.joints.clone(),

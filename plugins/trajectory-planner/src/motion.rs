@@ -361,8 +361,8 @@ pub fn plan_motion(
         [
             reach_phase,
             approach.iter().map(|q| s.p(q)).collect(),
-            close_phase(&s, open, closed),
-            squeeze_lift(&s, lift),
+            vec![open, closed],
+            lift,
         ],
     );
     progress("done", samples);
@@ -371,33 +371,6 @@ pub fn plan_motion(
         samples,
         checks: s.checks,
     })
-}
-
-/// The close phase: open to the grasp posture, then — with a squeeze — on to
-/// the squeeze targets (a servo command beyond contact: the fingers stop on
-/// the object and press; the posture checked is the grasp's).
-fn close_phase(s: &Scene<'_>, open: Vec<f64>, closed: Vec<f64>) -> Vec<Vec<f64>> {
-    let squeezed = s.p(&s.goal.squeezed);
-    match squeezed == closed {
-        true => vec![open, closed],
-        false => vec![open, closed, squeezed],
-    }
-}
-
-/// The lift with the hand joints at their squeeze targets: the fingers keep
-/// pressing while the arm lifts (the collision checks were made with the
-/// hand at the grasp posture, where it physically is).
-fn squeeze_lift(s: &Scene<'_>, mut lift: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
-    let squeezed = s.p(&s.goal.squeezed);
-    let closed = s.p(&s.goal.closed);
-    for point in &mut lift {
-        for (k, v) in point.iter_mut().enumerate() {
-            if (closed[k] - squeezed[k]).abs() > 0.0 {
-                *v = squeezed[k];
-            }
-        }
-    }
-    lift
 }
 
 /// How far the hand opens for the approach, tried in order: as wide as the

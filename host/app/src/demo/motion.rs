@@ -157,22 +157,11 @@ pub struct PartRun {
     pub wall_ms: f64,
 }
 
-/// The grasp as commanded: the Plan reply's joint positions with the squeeze's
-/// targets on the hand joints it lists (the close phase ends there; a real
-/// hand stops on the object at `joint_positions` and presses with the rest).
-fn commanded(grasp: &PlanReply) -> std::collections::BTreeMap<String, f64> {
-    let mut q = grasp.joint_positions.clone();
-    for s in &grasp.squeeze {
-        q.insert(s.joint.clone(), s.target);
-    }
-    q
-}
-
 /// The whole run: reach to the grasp, then lift.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct ExecutionRun {
     /// From the start to the end of `close`; its target is the Plan reply's
-    /// `joint_positions` with the squeeze's targets.
+    /// `joint_positions`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub grasp: Option<PartRun>,
     /// The lift; its target is the trajectory's last point.
@@ -186,7 +175,7 @@ pub struct ExecutionRun {
 /// Runs `trajectory` on the controller (at `speed` times real time) and checks
 /// where it ends: `ok` when both parts ran to the end and each ended at its
 /// target within [`STATE_TOLERANCE`] — the grasp part at the grasp planner's
-/// joint positions, squeezed.
+/// joint positions.
 pub fn execute(
     client: &BusClient,
     trajectory: &JointTrajectory,
@@ -209,7 +198,7 @@ fn run_parts(
 ) -> Result<(), String> {
     let (to_grasp, lift) = split_at_grasp(trajectory)?;
     let states = StateStream::subscribe(client)?;
-    let run = run_part(client, &states, &to_grasp, speed, &commanded(grasp))?;
+    let run = run_part(client, &states, &to_grasp, speed, &grasp.joint_positions)?;
     check.joints_not_driven = grasp
         .joint_positions
         .keys()
