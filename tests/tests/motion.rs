@@ -330,7 +330,10 @@ fn plan_and_recheck(name: &str) {
         reply.planning_ms
     );
     assert!(checks > 1000, "{name}: {checks} re-checks");
-    let c = reply.clearance.as_ref().expect("every paper scene has obstacles");
+    let c = reply
+        .clearance
+        .as_ref()
+        .expect("every paper scene has obstacles");
     eprintln!(
         "{name}: nearest an obstacle: {:.1} mm, {} to {} in {} at {:.2} s",
         c.distance * 1e3,
@@ -503,7 +506,10 @@ fn refusal(r: Result<MotionPlanReply, RequestError>) -> tsukami_msgs::error::Err
     match r {
         Err(RequestError::Reply(e)) => e.error,
         Err(other) => panic!("expected a refusal: {other}"),
-        Ok(m) => panic!("expected a refusal, got a motion (clearance {:?})", m.clearance),
+        Ok(m) => panic!(
+            "expected a refusal, got a motion (clearance {:?})",
+            m.clearance
+        ),
     }
 }
 
@@ -527,14 +533,26 @@ fn a_grasp_of_another_world_version_is_refused_naming_both() {
     let d = e.details.clone().unwrap();
     assert_eq!(d["reason"], "world_changed");
     assert_eq!(d["field"], "grasp.world_version");
-    assert_eq!((d["grasp_world_version"].as_u64(), d["world_version"].as_u64()), (Some(v), Some(v + 1)));
-    let both = format!("planned on world version {v}, but the world is at version {}", v + 1);
+    assert_eq!(
+        (
+            d["grasp_world_version"].as_u64(),
+            d["world_version"].as_u64()
+        ),
+        (Some(v), Some(v + 1))
+    );
+    let both = format!(
+        "planned on world version {v}, but the world is at version {}",
+        v + 1
+    );
     assert!(e.message.contains(&both), "{}", e.message);
     let again = json!({ "grasp": grasp, "revalidate": true, "seed": 1 });
     let e = refusal(motion(&bus.client, &again));
     assert_eq!(e.code, ErrorCode::Infeasible, "{}", e.message);
     assert_eq!(e.details.clone().unwrap()["reason"], "grasp_invalid");
-    let both = format!("planned on world version {v} does not hold on version {}", v + 1);
+    let both = format!(
+        "planned on world version {v} does not hold on version {}",
+        v + 1
+    );
     assert!(e.message.contains(&both), "{}", e.message);
     assert_eq!(set_object(&bus.client, &object), v + 2);
     let r = motion(&bus.client, &again).expect("the grasp holds with the can back");
@@ -561,7 +579,10 @@ fn an_obstacle_at_the_elbow_fails_the_revalidation_naming_it() {
         &bus.client,
         vec![board("post", [at.x, at.y, at.z], [0.06, 0.06, 0.06])],
     );
-    let e = refusal(motion(&bus.client, &json!({ "grasp": grasp, "revalidate": true })));
+    let e = refusal(motion(
+        &bus.client,
+        &json!({ "grasp": grasp, "revalidate": true }),
+    ));
     assert_eq!(e.code, ErrorCode::Infeasible);
     assert_eq!(
         e.details.as_ref().unwrap()["reason"],

@@ -163,7 +163,11 @@ fn host_to_plugin_world_commands_are_not_bus_commands() {
     };
     let prepare = serde_json::to_vec(&forged).unwrap();
     let commit = serde_json::to_vec(&WorldVersion { version: v + 40 }).unwrap();
-    for role in [ROLE_GRASP_PLANNER, ROLE_TRAJECTORY_PLANNER, ROLE_RESULT_VIEWER] {
+    for role in [
+        ROLE_GRASP_PLANNER,
+        ROLE_TRAJECTORY_PLANNER,
+        ROLE_RESULT_VIEWER,
+    ] {
         for (command, payload) in [
             (wk::PREPARE, &prepare),
             (wk::COMMIT, &commit),
@@ -180,7 +184,10 @@ fn host_to_plugin_world_commands_are_not_bus_commands() {
     }
     let state = world(c, "get", "{}").unwrap();
     assert_eq!(state["version"], v);
-    assert_eq!(state["object"]["pose"]["position"], json!([0.45, -0.25, 1.05]));
+    assert_eq!(
+        state["object"]["pose"]["position"],
+        json!([0.45, -0.25, 1.05])
+    );
     let grasp = plan(c, ROLE_GRASP_PLANNER, r#"{"seed": 1}"#).unwrap();
     assert_eq!(grasp["world_version"], v);
     assert_eq!(grasp["object"]["center_of_mass"], object["center_of_mass"]);

@@ -5,8 +5,8 @@
 
 use std::path::Path;
 use std::process::Command;
-use std::sync::mpsc;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 use tsukami_bus::{free_loopback_port, BusClient, BusConfig, ComponentArgs, RequestError};
 use tsukami_controller::{ControllerNode, Executor, JointTable, NodeOptions};
@@ -229,7 +229,9 @@ fn latest_tick(client: &BusClient) -> u64 {
     let bytes = client
         .request_key(&client.keys().controller_state(), b"", T)
         .unwrap();
-    serde_json::from_slice::<ControllerState>(&bytes).unwrap().tick
+    serde_json::from_slice::<ControllerState>(&bytes)
+        .unwrap()
+        .tick
 }
 
 /// 1500 refused `execute` requests (half an unknown joint, refused by the checks,
@@ -290,10 +292,19 @@ fn a_flood_of_refused_requests_holds_up_neither_the_periods_nor_a_stop() {
         .count() as u64;
     let periods = tick1 - tick0;
     assert!(run.stop_reply.stopped);
-    assert_eq!(run.reply.outcome, Some(ExecutionOutcome::Cancelled), "{:?}", run.reply);
+    assert_eq!(
+        run.reply.outcome,
+        Some(ExecutionOutcome::Cancelled),
+        "{:?}",
+        run.reply
+    );
     let end = run.reply.state.unwrap();
     let asked = run.reply.stop_requested_at.unwrap();
-    assert_eq!(end.tick, asked + 1, "the run ends one period after the stop");
+    assert_eq!(
+        end.tick,
+        asked + 1,
+        "the run ends one period after the stop"
+    );
     eprintln!(
         "flood of {FLOOD}: {:.3} s wall, {} periods ({:.3} s of controller time), \
          {published} of their states received; stop reply to end of run {:.4} s",
@@ -365,7 +376,13 @@ fn oversized_payloads_are_refused_and_do_not_grow_the_controller() {
     let endpoint = format!("tcp/127.0.0.1:{port}");
     let namespace = format!("big-{port}");
     let mut child = Command::new(env!("CARGO_BIN_EXE_tsukami-controller"))
-        .args(["--listen", &endpoint, "--namespace", &namespace, "--models-dir"])
+        .args([
+            "--listen",
+            &endpoint,
+            "--namespace",
+            &namespace,
+            "--models-dir",
+        ])
         .arg(models())
         .stderr(std::process::Stdio::null())
         .spawn()
@@ -377,7 +394,11 @@ fn oversized_payloads_are_refused_and_do_not_grow_the_controller() {
 
     let over = vec![b' '; MAX_PAYLOAD_BYTES + 1024];
     let refused = client.request_key(&key, &over, T).unwrap_err();
-    assert_eq!(refused.code(), Some(ErrorCode::PayloadTooLarge), "{refused}");
+    assert_eq!(
+        refused.code(),
+        Some(ErrorCode::PayloadTooLarge),
+        "{refused}"
+    );
     assert!(
         refused.to_string().contains(&MAX_PAYLOAD_BYTES.to_string()),
         "{refused} should name the limit"
@@ -426,8 +447,8 @@ fn a_wildcard_info_query_lists_every_component() {
         connect: vec![],
         ..ComponentArgs::connecting(&namespace, &probe_endpoint)
     };
-    let probe = tsukami_bus::Component::start("probe", "0.0.0", "a second component", &probe_args)
-        .unwrap();
+    let probe =
+        tsukami_bus::Component::start("probe", "0.0.0", "a second component", &probe_args).unwrap();
     // A client of both (peers do not forward for each other).
     let endpoints = vec![node_endpoint(&namespace), probe_endpoint];
     let bus = BusConfig {

@@ -101,7 +101,8 @@ pub struct DetectParams {
     /// A pose is reported only at this confidence or more.
     pub min_confidence: f64,
     /// Base-frame direction the x axis of a symmetric object's reported pose follows.
-    pub preferred_x: Vector3<f64>,    /// Most points of one segment (and of the cluster it is verified against):
+    pub preferred_x: Vector3<f64>,
+    /// Most points of one segment (and of the cluster it is verified against):
     /// a larger one is thinned evenly to this many (deterministic).
     pub max_segment_points: usize,
     /// The work budget of one detection, in point evaluations (a point of the
@@ -476,8 +477,8 @@ fn best_fine(
     for h in coarse.iter().take(view.params.max_fine) {
         let seg = &segments[h.segment];
         let p = view.params;
-        let cost = p.fine_points * (p.fine.iterations + p.exact_iterations)
-            + clusters[seg.parent].len();
+        let cost =
+            p.fine_points * (p.fine.iterations + p.exact_iterations) + clusters[seg.parent].len();
         if !view.spend(cost) {
             break;
         }
@@ -596,7 +597,9 @@ fn gather(view: &View, pose: &Isometry3<f64>) -> Vec<Point3<f64>> {
         clamp(v + r + 1.0, k.height),
     ];
     // Every pixel of the region is looked at.
-    view.spend(region[2].saturating_sub(region[0]) as usize * region[3].saturating_sub(region[1]) as usize);
+    view.spend(
+        region[2].saturating_sub(region[0]) as usize * region[3].saturating_sub(region[1]) as usize,
+    );
     let inv = pose.inverse();
     let gate2 = params.gather * params.gather;
     let centre = pose * template.moments.centroid;

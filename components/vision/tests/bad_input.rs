@@ -242,7 +242,11 @@ fn one_cluster_of_every_point_is_bounded_work() {
         started.elapsed().as_secs_f64()
     );
     assert_eq!(err.error.code, ErrorCode::Infeasible, "{err}");
-    assert!(err.error.message.contains("max_work"), "{}", err.error.message);
+    assert!(
+        err.error.message.contains("max_work"),
+        "{}",
+        err.error.message
+    );
     // A budget the cloud alone overruns: nothing is fitted, and the answer says so.
     let tight = DetectParams {
         max_work: 1000,

@@ -122,12 +122,21 @@ fn vision_component_over_the_bus() {
     // Over the payload limit: refused naming it (before it is queued), a message
     // over zenoh's reassembly cap dropped (no reply); still serving.
     let over = vec![b' '; tsukami_bus::MAX_PAYLOAD_BYTES + 1024];
-    let refused = client.request_key(&key, &over, Duration::from_secs(60)).unwrap_err();
-    assert_eq!(refused.code(), Some(ErrorCode::PayloadTooLarge), "{refused}");
+    let refused = client
+        .request_key(&key, &over, Duration::from_secs(60))
+        .unwrap_err();
+    assert_eq!(
+        refused.code(),
+        Some(ErrorCode::PayloadTooLarge),
+        "{refused}"
+    );
     assert!(refused.to_string().contains("16777216"), "{refused}");
     let huge = vec![b' '; 64 << 20];
     let dropped = client.request_key(&key, &huge, Duration::from_secs(10));
-    assert!(matches!(dropped, Err(RequestError::Timeout { .. })), "{dropped:?}");
+    assert!(
+        matches!(dropped, Err(RequestError::Timeout { .. })),
+        "{dropped:?}"
+    );
     assert!(ask(r#"{"object": "can_350ml", "seed": 3}"#).is_ok());
 
     // SIGTERM: a clean exit.

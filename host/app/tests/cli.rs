@@ -280,13 +280,28 @@ fn model_grasp_types_proposes_a_file_that_loads_or_names_what_is_missing() {
 
 #[test]
 fn model_allowed_collisions_proposes_pairs_with_reasons_deterministically() {
-    let robot = repo().join("models/robots/iiwa_allegro").display().to_string();
+    let robot = repo()
+        .join("models/robots/iiwa_allegro")
+        .display()
+        .to_string();
     let run = |seed: &str| {
         let out = tsukami(
-            &["model", "allowed-collisions", &robot, "--samples", "150", "--seed", seed],
+            &[
+                "model",
+                "allowed-collisions",
+                &robot,
+                "--samples",
+                "150",
+                "--seed",
+                seed,
+            ],
             None,
         );
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         String::from_utf8(out.stdout).unwrap()
     };
     let text = run("4");
@@ -306,7 +321,10 @@ fn model_allowed_collisions_proposes_pairs_with_reasons_deterministically() {
     assert!(!text.contains("[\"palm_link\", \"link_13.0\"]"), "{text}");
     // The iiwa's base never meets its hand within the joint limits.
     assert!(text.contains("never in contact"), "{text}");
-    let zero = tsukami(&["model", "allowed-collisions", &robot, "--samples", "0"], None);
+    let zero = tsukami(
+        &["model", "allowed-collisions", &robot, "--samples", "0"],
+        None,
+    );
     assert!(!zero.status.success());
     assert!(String::from_utf8_lossy(&zero.stderr).contains("--samples"));
 }

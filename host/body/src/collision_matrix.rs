@@ -74,7 +74,11 @@ pub fn random_posture(model: &RobotModel, rng: &mut ChaCha8Rng) -> Vec<f64> {
         };
         let lo = joint.limits.lower.max(-span);
         let hi = joint.limits.upper.min(span);
-        q[j] = if hi > lo { rng.random_range(lo..=hi) } else { lo };
+        q[j] = if hi > lo {
+            rng.random_range(lo..=hi)
+        } else {
+            lo
+        };
     }
     model.apply_mimics(&mut q);
     q
@@ -183,7 +187,10 @@ mod tests {
         let p = propose_allowed(&model, &collision, 300, 7);
         let reason = |a: &str, b: &str| {
             let (a, b) = (id(a).min(id(b)), id(a).max(id(b)));
-            p.pairs.iter().find(|x| (x.a, x.b) == (a, b)).map(|x| x.reason)
+            p.pairs
+                .iter()
+                .find(|x| (x.a, x.b) == (a, b))
+                .map(|x| x.reason)
         };
         assert_eq!(reason("arm2", "housing"), Some(Reason::Always));
         assert_eq!(reason("base", "arm2"), Some(Reason::Never));
@@ -191,15 +198,31 @@ mod tests {
         // arm1 and tip cross when j1 and j4 agree: a real collision, kept.
         assert_eq!(reason("arm1", "tip"), None);
         let (a, t) = (id("arm1"), id("tip"));
-        let kept = p.sometimes.iter().find(|s| (s.0, s.1) == (a.min(t), a.max(t)));
-        assert!(kept.is_some_and(|s| s.2 > 0 && s.2 < 300), "{:?}", p.sometimes);
+        let kept = p
+            .sometimes
+            .iter()
+            .find(|s| (s.0, s.1) == (a.min(t), a.max(t)));
+        assert!(
+            kept.is_some_and(|s| s.2 > 0 && s.2 < 300),
+            "{:?}",
+            p.sometimes
+        );
         // Adjacent pairs are never checked, so never proposed.
         assert_eq!(reason("base", "arm1"), None);
         let toml = to_toml(&model, &p);
-        assert!(toml.contains("[\"arm2\", \"housing\"],  # in contact in all 300 postures"), "{toml}");
-        assert!(toml.contains("[\"base\", \"arm2\"],  # never in contact in 300 postures"), "{toml}");
+        assert!(
+            toml.contains("[\"arm2\", \"housing\"],  # in contact in all 300 postures"),
+            "{toml}"
+        );
+        assert!(
+            toml.contains("[\"base\", \"arm2\"],  # never in contact in 300 postures"),
+            "{toml}"
+        );
         let parsed: toml::Table = toml::from_str(&toml).unwrap();
-        assert_eq!(parsed["allowed_collisions"].as_array().unwrap().len(), p.pairs.len());
+        assert_eq!(
+            parsed["allowed_collisions"].as_array().unwrap().len(),
+            p.pairs.len()
+        );
     }
 
     #[test]

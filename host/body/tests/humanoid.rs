@@ -171,7 +171,15 @@ fn the_torso_clears_the_pelvis_over_the_waist_and_squat_range() {
     let m = common::humanoid();
     let c = RobotCollision::new(&m).unwrap();
     let mut fk = FkState::new(&m);
-    let torso = ["base_link", "pelvis", "waist_link", "chest", "neck_link", "head_link", "l_arm_stub"];
+    let torso = [
+        "base_link",
+        "pelvis",
+        "waist_link",
+        "chest",
+        "neck_link",
+        "head_link",
+        "l_arm_stub",
+    ];
     let torso: Vec<usize> = torso.iter().map(|n| m.link_id(n).unwrap()).collect();
     let steps = |lo: f64, hi: f64| (0..=8).map(move |i| lo + (hi - lo) * f64::from(i) / 8.0);
     for yaw in steps(-0.8, 0.8) {
@@ -193,7 +201,10 @@ fn the_torso_clears_the_pelvis_over_the_waist_and_squat_range() {
                         .filter(|(a, b)| torso.contains(a) && torso.contains(b))
                         .map(|(a, b)| (m.links[a].name.as_str(), m.links[b].name.as_str()))
                         .collect();
-                    assert!(hits.is_empty(), "yaw {yaw}, pitch {pitch}, squat {squat}: {hits:?}");
+                    assert!(
+                        hits.is_empty(),
+                        "yaw {yaw}, pitch {pitch}, squat {squat}: {hits:?}"
+                    );
                 }
             }
         }

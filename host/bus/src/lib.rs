@@ -28,6 +28,6 @@ pub use config::{
     check_loopback, default_endpoint, free_loopback_port, reassembly_cap, BusConfig, BusMode,
     DEFAULT_PORT, DEFAULT_ROUTER_PORT,
 };
-pub use serve::MAX_PAYLOAD_BYTES;
 pub use logging::init_logging;
+pub use serve::MAX_PAYLOAD_BYTES;
 pub use shutdown::Shutdown;

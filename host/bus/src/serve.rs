@@ -124,7 +124,11 @@ mod tests {
         let big = vec![b' '; MAX_PAYLOAD_BYTES + 1];
         let too_large = parse_payload::<Req>(&big).unwrap_err().error;
         assert_eq!(too_large.code, ErrorCode::PayloadTooLarge);
-        assert!(too_large.message.contains("16777216"), "{}", too_large.message);
+        assert!(
+            too_large.message.contains("16777216"),
+            "{}",
+            too_large.message
+        );
         assert_eq!(too_large.details.unwrap()["limit"], MAX_PAYLOAD_BYTES);
         assert_eq!(crate::reassembly_cap(MAX_PAYLOAD_BYTES), 33 << 20);
         assert_eq!(

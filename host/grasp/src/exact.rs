@@ -230,8 +230,22 @@ fn solve(
             let rows = t.rows(i, &c.frame());
             for j in 0..m {
                 for k in 0..3 {
-                    push(row + j, 3 * i + k, rows[(k, j)], &mut ri, &mut ci, &mut vals);
-                    push(row + m + j, 3 * i + k, -rows[(k, j)], &mut ri, &mut ci, &mut vals);
+                    push(
+                        row + j,
+                        3 * i + k,
+                        rows[(k, j)],
+                        &mut ri,
+                        &mut ci,
+                        &mut vals,
+                    );
+                    push(
+                        row + m + j,
+                        3 * i + k,
+                        -rows[(k, j)],
+                        &mut ri,
+                        &mut ci,
+                        &mut vals,
+                    );
                 }
             }
         }

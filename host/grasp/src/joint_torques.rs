@@ -180,7 +180,11 @@ mod tests {
         let j = Matrix3xX::from_columns(&[Vector3::x()]);
         assert!(matches!(
             JointTorques::new(vec![j.clone()], vec![1.0, 1.0]),
-            Err(JointTorqueError::Columns { contact: 0, columns: 1, joints: 2 })
+            Err(JointTorqueError::Columns {
+                contact: 0,
+                columns: 1,
+                joints: 2
+            })
         ));
         assert!(matches!(
             JointTorques::new(vec![j.clone()], vec![-1.0]),

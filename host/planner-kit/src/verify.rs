@@ -36,10 +36,10 @@ use tsukami_body::model::LinkId;
 use crate::blocks::grasp_check::check_in;
 use crate::blocks::hold::{hold, squeeze, HoldContact, HoldProblem};
 use crate::blocks::wrap::{style_check, StyleRule};
-use tsukami_msgs::planner::{DisturbanceSet, HoldRequest, JointSqueeze};
 use crate::grasp::{FingerContact, Grasp};
 use crate::object::Object;
 use crate::planner::{GraspPlanner, World};
+use tsukami_msgs::planner::{DisturbanceSet, HoldRequest, JointSqueeze};
 
 /// Gravity in the world frame (z up), m/s².
 pub const GRAVITY: Vector3<f64> = Vector3::new(0.0, 0.0, -9.81);
@@ -225,8 +225,8 @@ pub fn holds<P: GraspPlanner>(
     req: &HoldRequest,
 ) -> Result<tsukami_grasp::hold::HoldVerdict, String> {
     let problem = hold_problem(world, fk, length);
-    let v = hold(&problem, &hold_contacts(contacts), req)
-        .ok_or("the hold test could not be solved")?;
+    let v =
+        hold(&problem, &hold_contacts(contacts), req).ok_or("the hold test could not be solved")?;
     if req.disturbances == DisturbanceSet::Standard && !v.force_closure {
         return Err("the contacts are not in force closure".into());
     }
@@ -286,7 +286,14 @@ fn hold_checks<P: GraspPlanner>(
                 .map_or(0.0, |p| p.distance.max(0.0))
         })
         .collect();
-    let s = squeeze(&problem, &contacts, &gaps, &grasp.q, hand.servo_saturation, req);
+    let s = squeeze(
+        &problem,
+        &contacts,
+        &gaps,
+        &grasp.q,
+        hand.servo_saturation,
+        req,
+    );
     verdict.squeeze = s.ok_or("no squeeze the joints can make balances the contacts")?;
     Ok(())
 }

@@ -69,11 +69,11 @@ use tsukami_body::kinematics::{FkState, JointSelection};
 use tsukami_body::model::{Geometry, LinkId};
 use tsukami_grasp::contact::Contact;
 use tsukami_grasp::exact::{exact_weight_scale, ConeModel};
+use tsukami_grasp::finger_force::max_finger_force;
+use tsukami_grasp::grasp::Grasp;
 use tsukami_grasp::hold::{hold_test, Disturbances, HoldOptions};
 use tsukami_grasp::joint_torques::JointTorques;
 use tsukami_msgs::planner::DisturbanceSet;
-use tsukami_grasp::finger_force::max_finger_force;
-use tsukami_grasp::grasp::Grasp;
 use tsukami_msgs::planner::{ContactReply, PlanReply};
 
 use crate::geometry::pose_to_isometry;
@@ -679,7 +679,11 @@ fn check_hold(
         jacobians.push(Matrix3xX::from_fn(sel.len(), |row, k| j6[(row, k)]));
         contacts.push(contact);
     }
-    let efforts = sel.joints.iter().map(|&k| model.joints[k].limits.effort).collect();
+    let efforts = sel
+        .joints
+        .iter()
+        .map(|&k| model.joints[k].limits.effort)
+        .collect();
     let unlimited = vec![1e6; contacts.len()];
     let length = o.mesh.bounding_diagonal();
     let (Ok(grasp), Ok(torques)) = (

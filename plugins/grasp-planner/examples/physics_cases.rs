@@ -78,12 +78,13 @@ fn object_json(req: &SetObject) -> Value {
         ObjectShape::Model { name } => {
             let dir = models().join("objects").join(name);
             let m: toml::Value =
-                toml::from_str(&std::fs::read_to_string(dir.join("object.toml")).unwrap())
-                    .unwrap();
+                toml::from_str(&std::fs::read_to_string(dir.join("object.toml")).unwrap()).unwrap();
             let mesh = &m["shape"]["mesh"];
             (
                 dir.join(mesh["path"].as_str().expect("a mesh model")),
-                mesh.get("scale").and_then(toml::Value::as_float).unwrap_or(1.0),
+                mesh.get("scale")
+                    .and_then(toml::Value::as_float)
+                    .unwrap_or(1.0),
                 m.get("friction").and_then(toml::Value::as_float),
             )
         }
@@ -110,7 +111,15 @@ struct Exporter {
 
 impl Exporter {
     /// Plans one case and writes it when a grasp is returned.
-    fn case(&mut self, name: &str, family: &str, placement: &str, robot: &Value, object: &SetObject, env: &SetEnv) {
+    fn case(
+        &mut self,
+        name: &str,
+        family: &str,
+        placement: &str,
+        robot: &Value,
+        object: &SetObject,
+        env: &SetEnv,
+    ) {
         if self.written >= self.limit {
             return;
         }
@@ -127,7 +136,10 @@ impl Exporter {
             seed: self.seed,
             ..PlanOptions::default()
         };
-        match self.planner.plan(&opts, &AtomicBool::new(false), &mut |_| {}) {
+        match self
+            .planner
+            .plan(&opts, &AtomicBool::new(false), &mut |_| {})
+        {
             Ok(reply) => {
                 let line = json!({
                     "case": name,

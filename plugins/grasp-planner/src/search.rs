@@ -352,8 +352,7 @@ fn accept(
         return None;
     }
     let t_exact = Instant::now();
-    let exact = exact_resists(ctx.object, &grasp, 1.0, &mut counters.hints)
-        && holds(ctx, closed);
+    let exact = exact_resists(ctx.object, &grasp, 1.0, &mut counters.hints) && holds(ctx, closed);
     *exact_ms += t_exact.elapsed().as_secs_f64() * 1e3;
     if !exact {
         counters.reject(4, None);

@@ -233,7 +233,12 @@ fn serve(
 ) -> io::Result<()> {
     let head = match read_head(&mut stream) {
         Ok(head) => head,
-        Err(e) if matches!(e.kind(), io::ErrorKind::TimedOut | io::ErrorKind::WouldBlock) => {
+        Err(e)
+            if matches!(
+                e.kind(),
+                io::ErrorKind::TimedOut | io::ErrorKind::WouldBlock
+            ) =>
+        {
             return respond(
                 &mut stream,
                 "408 Request Timeout",
@@ -310,7 +315,11 @@ fn events(mut stream: TcpStream, viewer: &Viewer, stop: &AtomicBool) -> io::Resu
             if viewer.board.wait_past(seen, KEEPALIVE).is_some() {
                 break;
             }
-            write_by(&mut stream, b": keep-alive\n\n", Instant::now() + IO_TIMEOUT)?;
+            write_by(
+                &mut stream,
+                b": keep-alive\n\n",
+                Instant::now() + IO_TIMEOUT,
+            )?;
         }
         std::thread::sleep(MIN_EVENT_INTERVAL.saturating_sub(sent_at.elapsed()));
     })();
@@ -325,7 +334,10 @@ fn write_by(stream: &mut TcpStream, mut bytes: &[u8], deadline: Instant) -> io::
     while !bytes.is_empty() {
         let left = deadline.saturating_duration_since(Instant::now());
         if left.is_zero() {
-            return Err(io::Error::new(io::ErrorKind::TimedOut, "event not taken in time"));
+            return Err(io::Error::new(
+                io::ErrorKind::TimedOut,
+                "event not taken in time",
+            ));
         }
         stream.set_write_timeout(Some(left))?;
         match stream.write(bytes) {

@@ -257,8 +257,13 @@ impl<'a> Scene<'a> {
             origin: object.pose.translation.vector,
             clearance: self.cfg.support_clearance,
         };
-        self.robot_world(self.env.clone(), self.joints.clone(), &self.goal.closed, 0.0)
-            .with_attached(attached)
+        self.robot_world(
+            self.env.clone(),
+            self.joints.clone(),
+            &self.goal.closed,
+            0.0,
+        )
+        .with_attached(attached)
     }
 
     fn check(&mut self, mut world: RobotWorld<'_>, path: &[Vec<f64>]) -> Result<(), Collision> {

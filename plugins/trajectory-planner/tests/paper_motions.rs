@@ -169,7 +169,9 @@ fn a_revalidated_grasp_holds_on_its_world_and_fails_once_the_object_moved() {
     world.set_object(&object).unwrap();
     let (moved, version) = plan(&world);
     match moved {
-        Err(MotionError::Infeasible { reason, message, .. }) => {
+        Err(MotionError::Infeasible {
+            reason, message, ..
+        }) => {
             assert_eq!(reason, "grasp_invalid");
             let versions = format!(
                 "planned on world version {} does not hold on version {version}",

@@ -106,7 +106,10 @@ impl Rejection {
                 format!("{} into {into}", model.links[*link].name)
             }
             Rejection::SelfCollision { link, other } => {
-                format!("{} vs {}", model.links[*link].name, model.links[*other].name)
+                format!(
+                    "{} vs {}",
+                    model.links[*link].name, model.links[*other].name
+                )
             }
             Rejection::Contact { link, .. } => {
                 format!("contact of {} off the surface", model.links[*link].name)

@@ -118,8 +118,8 @@ pub fn squeeze(
     req: &HoldRequest,
 ) -> Option<Vec<JointSqueeze>> {
     let (grasp, torques) = setup(p, contacts)?;
-    let s = tsukami_grasp::hold::squeeze(&grasp, &torques, req.squeeze_share, &options(req))
-        .ok()?;
+    let s =
+        tsukami_grasp::hold::squeeze(&grasp, &torques, req.squeeze_share, &options(req)).ok()?;
     let close = gap_motion(&torques, contacts, gaps);
     let out = p
         .joints
