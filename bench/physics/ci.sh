@@ -18,3 +18,12 @@ cargo run -q --profile "${PHYSICS_CI_PROFILE:-dev}" -p tsukami-grasp-planner --e
     --seed 1 --quick --limit "${PHYSICS_CI_CASES:-9}" --out "$out/humanoid.jsonl"
 python3 bench/physics/hold.py --cases "$out/humanoid.jsonl" --noise \
     --json "$out/results.json" --md "$out/results.md"
+# The controls as a closing count (hold.py has already exited non-zero if one
+# misbehaved; this line counts them from its results).
+python3 - "$out/results.json" <<'PY'
+import json, sys
+controls = json.load(open(sys.argv[1]))["controls"]
+ok = sum(1 for c in controls if c["ok"])
+print(f"physics controls: {ok} passed, {len(controls) - ok} failed")
+sys.exit(0 if ok == len(controls) else 1)
+PY
