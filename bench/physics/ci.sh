@@ -24,6 +24,6 @@ python3 - "$out/results.json" <<'PY'
 import json, sys
 controls = json.load(open(sys.argv[1]))["controls"]
 ok = sum(1 for c in controls if c["ok"])
-print(f"physics controls: {ok} passed, {len(controls) - ok} failed")
+print(f"physics: {ok} passed, {len(controls) - ok} failed")
 sys.exit(0 if ok == len(controls) else 1)
 PY
