@@ -459,6 +459,49 @@ pub struct HoldRequest {
     /// physics benchmark's grasps, 0.9 held 65 % (`docs/benchmarks.md`).
     #[serde(default = "default_squeeze_share")]
     pub squeeze_share: f64,
+    /// The object pose error the returned grasp is re-checked under
+    /// (`docs/force-closure.md`, "Robust to the object's pose").
+    #[serde(default)]
+    pub pose_error: PoseError,
+}
+
+/// `HoldRequest::pose_error`: how far the object may lie from where vision
+/// put it. The planner re-closes the hand on the object moved by each of
+/// `samples` errors (drawn from the plan's seed: the same seed, the same
+/// errors) and repeats the hold test; the reply says how many still hold
+/// and the planner prefers grasps that hold under all of them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PoseError {
+    /// Largest shift of the centre of mass, m (default 0.003; 0 to 0.05).
+    #[serde(default = "default_pose_shift")]
+    pub position: f64,
+    /// Largest turn about the centre of mass, degrees (default 3; 0 to 30).
+    #[serde(default = "default_pose_turn")]
+    pub rotation_deg: f64,
+    /// Errors sampled (default 8; 0 to 64; 0 turns the check off).
+    #[serde(default = "default_pose_samples")]
+    pub samples: u32,
+}
+
+fn default_pose_shift() -> f64 {
+    0.003
+}
+fn default_pose_turn() -> f64 {
+    3.0
+}
+fn default_pose_samples() -> u32 {
+    8
+}
+
+impl Default for PoseError {
+    fn default() -> Self {
+        Self {
+            position: default_pose_shift(),
+            rotation_deg: default_pose_turn(),
+            samples: default_pose_samples(),
+        }
+    }
 }
 
 fn default_com_error() -> f64 {
@@ -478,6 +521,7 @@ impl Default for HoldRequest {
             com_error: default_com_error(),
             friction_reserve: default_friction_reserve(),
             squeeze_share: default_squeeze_share(),
+            pose_error: PoseError::default(),
         }
     }
 }
@@ -616,6 +660,30 @@ pub struct ForceClosureReply {
     /// The disturbance set the grasp was checked against.
     #[serde(default)]
     pub disturbances: DisturbanceSet,
+    /// The hold test repeated under the request's object pose errors
+    /// (`HoldRequest::pose_error`).
+    #[serde(default)]
+    pub robustness: PoseRobustness,
+}
+
+/// How many of the sampled object pose errors the grasp still holds under:
+/// the hand re-closed on the moved object, the same hold test.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct PoseRobustness {
+    /// Errors sampled (0: not checked).
+    pub samples: u32,
+    /// Errors under which it still holds.
+    pub held: u32,
+}
+
+impl PoseRobustness {
+    /// The share that still hold (1 when none was sampled).
+    pub fn share(&self) -> f64 {
+        match self.samples {
+            0 => 1.0,
+            n => f64::from(self.held) / f64::from(n),
+        }
+    }
 }
 
 /// One joint's squeeze: what a hand controller applies after contact so the
@@ -790,6 +858,10 @@ mod tests {
                 force_closure: true,
                 hold_margin: 1.5,
                 disturbances: DisturbanceSet::Standard,
+                robustness: PoseRobustness {
+                    samples: 8,
+                    held: 7,
+                },
             },
             squeeze: vec![JointSqueeze {
                 joint: "r_index_j2".into(),

@@ -148,6 +148,7 @@ pub fn reply<P: GraspPlanner>(
             force_closure: verdict.force_closure,
             hold_margin: verdict.hold_margin,
             disturbances: verdict.disturbances,
+            robustness: verdict.robustness,
         },
         squeeze: verdict.squeeze.clone(),
         samples: run.samples,

@@ -36,9 +36,10 @@ use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use tsukami_msgs::planner::{PhaseTiming, PlanPhase, ProgressEvent};
+use tsukami_msgs::planner::{HoldRequest, PhaseTiming, PlanPhase, PoseRobustness, ProgressEvent};
 
-use crate::Stop;
+use crate::planner::{GraspPlanner, World};
+use crate::{Grasp, Stop};
 
 /// Most distinct names kept in each rejection table.
 pub const MAX_REASONS: usize = 32;
@@ -82,7 +83,12 @@ pub struct Run<'a> {
     grasp_type: Option<String>,
     joints_used: Vec<String>,
     tried: Vec<String>,
+    /// The last pose-robustness answer and what it was asked of.
+    robust_memo: Option<RobustMemo>,
 }
+
+/// A grasp, the request and seed it was re-checked under, and the answer.
+type RobustMemo = (Grasp, HoldRequest, u64, PoseRobustness);
 
 fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
@@ -110,7 +116,29 @@ impl<'a> Run<'a> {
             grasp_type: None,
             joints_used: Vec::new(),
             tried: Vec::new(),
+            robust_memo: None,
         }
+    }
+
+    /// How many of the request's object pose errors `grasp` still holds
+    /// under ([`crate::verify::robustness`], the kit's re-check). The last
+    /// answer is kept, so the verification of the grasp a planner chose on it
+    /// does not repeat the work.
+    pub fn pose_robustness<P: GraspPlanner>(
+        &mut self,
+        world: &World<'_, P>,
+        grasp: &Grasp,
+        req: &HoldRequest,
+        seed: u64,
+    ) -> PoseRobustness {
+        if let Some((g, r, s, answer)) = &self.robust_memo {
+            if g == grasp && r == req && *s == seed {
+                return *answer;
+            }
+        }
+        let answer = crate::verify::robustness(world, grasp, req, seed);
+        self.robust_memo = Some((grasp.clone(), *req, seed, answer));
+        answer
     }
 
     /// `Err` once the plan must stop: cancelled, or past the request's deadline.

@@ -242,7 +242,9 @@ impl<P: GraspPlanner> Session<P> {
                 })
             }
             Ok(grasp) => {
-                let verdict = verify(&world, &grasp, &opts.hold).map_err(KitError::Unverified)?;
+                let mut verdict =
+                    verify(&world, &grasp, &opts.hold).map_err(KitError::Unverified)?;
+                verdict.robustness = run.pose_robustness(&world, &grasp, &opts.hold, opts.seed);
                 let (timing, tried, samples) = run.finish();
                 let report = RunReport {
                     timing,

@@ -34,12 +34,13 @@ use tsukami_body::kinematics::FkState;
 use tsukami_body::model::LinkId;
 
 use crate::blocks::grasp_check::check_in;
-use crate::blocks::hold::{hold, squeeze, HoldContact, HoldProblem};
+use crate::blocks::hold::{holds_under, squeeze, HoldContact, HoldProblem};
+use crate::blocks::robust::{pose_robustness, RobustProblem};
 use crate::blocks::wrap::{style_check, StyleRule};
 use crate::grasp::{FingerContact, Grasp};
 use crate::object::Object;
 use crate::planner::{GraspPlanner, World};
-use tsukami_msgs::planner::{DisturbanceSet, HoldRequest, JointSqueeze};
+use tsukami_msgs::planner::{DisturbanceSet, HoldRequest, JointSqueeze, PoseRobustness};
 
 /// Gravity in the world frame (z up), m/s².
 pub const GRAVITY: Vector3<f64> = Vector3::new(0.0, 0.0, -9.81);
@@ -65,6 +66,8 @@ pub struct Verdict {
     pub disturbances: DisturbanceSet,
     /// The squeeze per independent hand joint.
     pub squeeze: Vec<JointSqueeze>,
+    /// The hold test under the request's object pose errors ([`robustness`]).
+    pub robustness: PoseRobustness,
 }
 
 /// The paper's single maximum finger force of a contact set: the weakest `f_max`.
@@ -99,6 +102,7 @@ pub fn force_closure(object: &Object, contacts: &[FingerContact], length: f64) -
         hold_margin: 0.0,
         disturbances: DisturbanceSet::Gravity,
         squeeze: Vec::new(),
+        robustness: PoseRobustness::default(),
     })
 }
 
@@ -174,10 +178,7 @@ pub fn verify<P: GraspPlanner>(
 ) -> Result<Verdict, String> {
     shape_checks(world, grasp)?;
     geometric_checks(world, grasp)?;
-    let length = grasp
-        .characteristic_length
-        .filter(|l| l.is_finite() && *l > 0.0)
-        .unwrap_or_else(|| world.object.characteristic_length());
+    let length = grasp_length(world, grasp);
     let mut verdict = force_closure(world.object, &grasp.contacts, length)
         .ok_or("the contacts make no valid grasp matrix")?;
     if !verdict.exact_resists_weight || !verdict.margin.is_finite() {
@@ -224,19 +225,67 @@ pub fn holds<P: GraspPlanner>(
     length: f64,
     req: &HoldRequest,
 ) -> Result<tsukami_grasp::hold::HoldVerdict, String> {
-    let problem = hold_problem(world, fk, length);
-    let v =
-        hold(&problem, &hold_contacts(contacts), req).ok_or("the hold test could not be solved")?;
-    if req.disturbances == DisturbanceSet::Standard && !v.force_closure {
-        return Err("the contacts are not in force closure".into());
-    }
-    if !v.holds() {
-        return Err(format!(
-            "the joints' torques cannot hold the disturbances: the worst is resisted {:.2} times",
-            v.margin
-        ));
-    }
-    Ok(v)
+    holds_under(
+        &hold_problem(world, fk, length),
+        &hold_contacts(contacts),
+        req,
+    )
+}
+
+/// How many of the request's object pose errors (drawn from the plan's
+/// `seed`) `grasp` still holds under ([`crate::blocks::robust`]): the hand
+/// re-closed on the moved object, the rule of [`holds`]. Planners that
+/// prefer robust grasps call it through [`crate::Run::pose_robustness`],
+/// which keeps the answer for the verification of the same grasp.
+pub fn robustness<P: GraspPlanner>(
+    world: &World<'_, P>,
+    grasp: &Grasp,
+    req: &HoldRequest,
+    seed: u64,
+) -> PoseRobustness {
+    let model = &world.robot.model;
+    let mut fk = FkState::new(model);
+    model.forward_kinematics(&grasp.q, &mut fk);
+    let rule = style_rule(world, grasp, &fk);
+    let problem = RobustProblem {
+        robot: world.robot,
+        hand: world.hand(),
+        object: world.object,
+        length: grasp_length(world, grasp),
+        palm_approach: rule.palm_contact.then_some(rule.approach),
+        closing: closing_joints(world, grasp),
+    };
+    pose_robustness(&problem, &grasp.q, &grasp.contacts, req, seed)
+}
+
+/// The closing joints of the grasp's type in the hand's grasp-type file
+/// (none for a type it does not list).
+fn closing_joints<P: GraspPlanner>(
+    world: &World<'_, P>,
+    grasp: &Grasp,
+) -> Vec<tsukami_body::model::JointId> {
+    let model = &world.robot.model;
+    world
+        .hand()
+        .grasp_types
+        .grasp_types
+        .iter()
+        .find(|g| g.name == grasp.grasp_type.name)
+        .map(|g| {
+            g.contacts
+                .iter()
+                .filter_map(|c| model.joint_id(&c.joint).ok())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// The characteristic length of `grasp`: its own when valid, else the object's.
+fn grasp_length<P: GraspPlanner>(world: &World<'_, P>, grasp: &Grasp) -> f64 {
+    grasp
+        .characteristic_length
+        .filter(|l| l.is_finite() && *l > 0.0)
+        .unwrap_or_else(|| world.object.characteristic_length())
 }
 
 /// The rule of the grasp's style ([`crate::blocks::wrap`]): the approach and

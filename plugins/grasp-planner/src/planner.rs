@@ -351,7 +351,10 @@ impl Paper {
                     &nom.q,
                     seed,
                     &mut t.counters,
-                    &mut |_| {},
+                    &mut |found| {
+                        let g = grasp(g.to_ref(), &nom.candidate, &stage, found.clone(), object);
+                        run.pose_robustness(w, &g, &opts.hold, opts.seed)
+                    },
                 );
                 run.record(t.counters.samples, t.counters.best_margin);
                 match outcome {

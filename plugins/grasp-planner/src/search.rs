@@ -30,6 +30,7 @@
 //! cancel flag and the deadline are checked before every sample (a sample
 //! takes well under a millisecond).
 
+use std::cell::Cell;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -49,7 +50,7 @@ use tsukami_grasp::exact::{
 use tsukami_grasp::grasp::Grasp;
 use tsukami_grasp::grasp_matrix::Wrench;
 
-use tsukami_msgs::planner::HoldRequest;
+use tsukami_msgs::planner::{HoldRequest, PoseRobustness};
 use tsukami_planner_kit::blocks::hold::{hold, HoldContact, HoldProblem};
 use tsukami_planner_kit::blocks::wrap::{style_check, StyleRule};
 
@@ -136,6 +137,8 @@ pub struct Found {
     pub exact_resists_weight: bool,
     /// Time spent in exact tests (ms).
     pub exact_ms: f64,
+    /// Of the request's object pose errors, how many it still holds under.
+    pub robustness: PoseRobustness,
 }
 
 /// How a search ended.
@@ -152,7 +155,7 @@ pub enum Outcome {
 }
 
 /// The reasons a sample is rejected, in the order of [`Counters::rejections`].
-pub const REJECTION_REASONS: [&str; 7] = [
+pub const REJECTION_REASONS: [&str; 8] = [
     "ik",
     "collision before closing",
     "finger closing",
@@ -160,7 +163,13 @@ pub const REJECTION_REASONS: [&str; 7] = [
     "force closure",
     "verification",
     "no wrap",
+    "pose error",
 ];
+
+/// Samples a search goes on drawing, after its first accepted grasp that
+/// some pose error drops, for one that holds under all of them; then the
+/// accepted grasp that held under the most is returned.
+pub const ROBUST_EXTRA_SAMPLES: u32 = 48;
 
 /// The gap (m) a palm-contact grasp type leaves between palm and object
 /// before the fingers close: the palm then touches within the contact distance.
@@ -174,7 +183,7 @@ pub struct Counters {
     /// Best ellipsoid margin seen.
     pub best_margin: Option<f64>,
     /// Why samples were rejected, per [`REJECTION_REASONS`].
-    pub rejections: [u32; 7],
+    pub rejections: [u32; 8],
     /// What blocked the collision-rejected samples: `"<link> vs <obstacle>"`
     /// (or `"… vs <link>"` for self-collision) with counts.
     pub blockers: BTreeMap<String, u32>,
@@ -206,8 +215,17 @@ impl Counters {
     }
 }
 
+/// The re-check of an accepted grasp under the request's object pose errors
+/// (the kit's, `tsukami_planner_kit::Run::pose_robustness`): how many it
+/// still holds under.
+pub type Robustness<'h> = dyn FnMut(&Found) -> PoseRobustness + 'h;
+
 /// Algorithm 1 around one nominal pose. `q_nominal` is the nominal IK solution
-/// (full vector) for grasp type `t` over `stage`.
+/// (full vector) for grasp type `t` over `stage`. The first accepted grasp
+/// that holds under every pose error is returned; one that some error drops
+/// is kept while the search goes on for at most [`ROBUST_EXTRA_SAMPLES`]
+/// samples, and the one that held under the most (the first of equals) is
+/// returned then.
 #[allow(clippy::too_many_arguments)]
 pub fn search(
     ctx: &SearchContext<'_>,
@@ -217,7 +235,56 @@ pub fn search(
     q_nominal: &[f64],
     seed: u64,
     counters: &mut Counters,
-    progress: &mut dyn FnMut(&Counters),
+    robustness: &mut Robustness<'_>,
+) -> Outcome {
+    let mut best: Option<Box<Found>> = None;
+    let stop_at = Cell::new(u32::MAX);
+    let outcome = sample_loop(
+        ctx,
+        (t, stage),
+        (nominal_palm, q_nominal),
+        seed,
+        counters,
+        &mut |found, at, counters| {
+            let r = robustness(&found);
+            let found = Box::new(Found {
+                robustness: r,
+                ..found
+            });
+            if r.held == r.samples {
+                return Some(Outcome::Found(found));
+            }
+            counters.reject(7, None);
+            if best.is_none() {
+                stop_at.set(at.saturating_add(ROBUST_EXTRA_SAMPLES));
+            }
+            if best.as_ref().is_none_or(|b| r.held > b.robustness.held) {
+                best = Some(found);
+            }
+            None
+        },
+        &stop_at,
+    );
+    match (outcome, best) {
+        (Outcome::Exhausted, Some(b)) => Outcome::Found(b),
+        (o, _) => o,
+    }
+}
+
+/// What [`sample_loop`] does with an accepted grasp (drawn at sample `at`):
+/// `Some` ends the loop with that outcome.
+type OnFound<'f> = dyn FnMut(Found, u32, &mut Counters) -> Option<Outcome> + 'f;
+
+/// The samples of Algorithm 1 until `on_found` ends them, the sample index
+/// reaches `stop_at`, or the budget is spent.
+fn sample_loop(
+    ctx: &SearchContext<'_>,
+    (t, stage): (usize, &StageJoints),
+    (nominal_palm, q_nominal): (&Isometry3<f64>, &[f64]),
+    seed: u64,
+    counters: &mut Counters,
+    on_found: &mut OnFound<'_>,
+    stop_at: &Cell<u32>,
 ) -> Outcome {
     let hand = ctx.hand;
     let p = ctx.params;
@@ -231,6 +298,9 @@ pub fn search(
     let mut q = q_nominal.to_vec();
     let mut exact_ms = 0.0;
     for s in 0..p.max_samples {
+        if s >= stop_at.get() {
+            break;
+        }
         if ctx.cancel.load(Ordering::Relaxed) {
             return Outcome::Cancelled;
         }
@@ -238,9 +308,6 @@ pub fn search(
             return Outcome::OutOfTime;
         }
         counters.samples += 1;
-        if counters.samples.is_multiple_of(16) {
-            progress(counters);
-        }
         let Some(palm) = sampler.draw(s, &mut q) else {
             counters.reject(0, None);
             continue;
@@ -287,15 +354,18 @@ pub fn search(
         let Some(margin) = accept(ctx, &closed, counters, &mut exact_ms) else {
             continue;
         };
-        progress(counters);
-        return Outcome::Found(Box::new(Found {
-            q,
+        let found = Found {
+            q: q.clone(),
             palm,
             contacts,
             margin,
             exact_resists_weight: true,
             exact_ms,
-        }));
+            robustness: PoseRobustness::default(),
+        };
+        if let Some(done) = on_found(found, s, counters) {
+            return done;
+        }
     }
     Outcome::Exhausted
 }

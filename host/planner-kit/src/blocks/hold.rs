@@ -172,3 +172,23 @@ fn gap_motion(torques: &JointTorques, contacts: &[HoldContact], gaps: &[f64]) ->
         None => vec![0.0; m],
     }
 }
+
+/// [`hold`] with the request's rule applied: closure when the set is the
+/// standard one, every disturbance balanced; the verdict or why not.
+pub fn holds_under(
+    p: &HoldProblem<'_>,
+    contacts: &[HoldContact],
+    req: &HoldRequest,
+) -> Result<HoldVerdict, String> {
+    let v = hold(p, contacts, req).ok_or("the hold test could not be solved")?;
+    if req.disturbances == DisturbanceSet::Standard && !v.force_closure {
+        return Err("the contacts are not in force closure".into());
+    }
+    if !v.holds() {
+        return Err(format!(
+            "the joints' torques cannot hold the disturbances: the worst is resisted {:.2} times",
+            v.margin
+        ));
+    }
+    Ok(v)
+}

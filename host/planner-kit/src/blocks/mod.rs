@@ -1,5 +1,5 @@
 //! Building blocks a planner may call or ignore: finger closing, finger force,
-//! collision passes, whole-body IK stages, grasp-type postures and surface
+//! collision passes, the hold rule and its re-check under pose errors, whole-body IK stages, grasp-type postures and surface
 //! sampling. Each works on the kit's
 //! [`crate::Robot`] / [`crate::Hand`] and knows nothing of any planner.
 
@@ -9,6 +9,7 @@ pub mod force;
 pub mod grasp_check;
 pub mod hold;
 pub mod posture;
+pub mod robust;
 pub mod stages;
 pub mod surface;
 pub mod wrap;
