@@ -29,7 +29,12 @@
 //! closure and `min_d s_d ≥ 1`; `min_d s_d` is the **hold margin** (how many
 //! times the worst disturbance it resists). Disturbances are tried in the
 //! order given and the test stops at the first one below 1 (its index is
-//! reported), so a search spends one program on most rejected samples.
+//! reported), so a search spends one program on most rejected samples. A
+//! deciding test ([`HoldOptions::decide_only`], what searches use) first
+//! tries each disturbance with the cheap sufficient test of
+//! [`crate::superposition`] on the squeeze, and solves the program only when
+//! that fails: the same verdict, one program instead of thirteen for most
+//! grasps that hold.
 //!
 //! ```
 //! use nalgebra::{Matrix3xX, Point3, Vector3};
@@ -60,10 +65,13 @@
 
 use nalgebra::{Point3, Vector3};
 
-use crate::exact::{exact_force_closure_with, exact_weight_scale_with, ConeModel, ExactError};
+use crate::exact::{
+    exact_force_closure_with, exact_weight_scale_with, ConeModel, ExactError, SQUEEZE_TOLERANCE,
+};
 use crate::grasp::Grasp;
 use crate::grasp_matrix::Wrench;
 use crate::joint_torques::JointTorques;
+use crate::superposition::Superposition;
 
 /// Options of the hold test.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -73,13 +81,25 @@ pub struct HoldOptions {
     pub friction_reserve: f64,
     /// Require exact force closure (default true).
     pub require_closure: bool,
+    /// Decide only (default false): a disturbance that the squeeze plus the
+    /// least-norm forces balance at [`DECIDE_SAFETY`] times
+    /// ([`crate::superposition`]) is passed without its program, and its
+    /// scale is reported as [`DECIDE_SAFETY`], a lower bound. The verdict
+    /// `holds()` is the same as the exact one's; the margins are not.
+    pub decide_only: bool,
 }
+
+/// The multiple of a disturbance the cheap test of a deciding hold test
+/// must balance (a 1 % reserve over the solver's rounding, so that the exact
+/// program agrees).
+pub const DECIDE_SAFETY: f64 = 1.01;
 
 impl Default for HoldOptions {
     fn default() -> Self {
         Self {
             friction_reserve: 0.2,
             require_closure: true,
+            decide_only: false,
         }
     }
 }
@@ -182,10 +202,9 @@ pub fn hold_test(
     set: &Disturbances,
     opts: &HoldOptions,
 ) -> Result<HoldVerdict, ExactError> {
-    let force_closure = match opts.require_closure {
-        true => exact_force_closure_with(grasp, ConeModel::Circular, None)?.force_closure,
-        false => true,
-    };
+    let reduced = with_reserve(grasp, opts.friction_reserve);
+    let g = reduced.as_ref().unwrap_or(grasp);
+    let (force_closure, fast) = closure(grasp, g, joints, opts)?;
     let mut out = HoldVerdict {
         force_closure,
         margin: 0.0,
@@ -195,14 +214,18 @@ pub fn hold_test(
     if !force_closure {
         return Ok(out);
     }
-    let reduced = with_reserve(grasp, opts.friction_reserve);
-    let g = reduced.as_ref().unwrap_or(grasp);
     out.margin = f64::INFINITY;
     for (i, d) in set.0.iter().enumerate() {
-        let s = exact_weight_scale_with(g, ConeModel::Circular, &d.wrench, Some(joints))?;
-        out.scales.push(s.weight_scale);
-        out.margin = out.margin.min(s.weight_scale);
-        if s.weight_scale < 1.0 {
+        let s = match &fast {
+            Some(f) if f.resists(&d.wrench, DECIDE_SAFETY) => DECIDE_SAFETY,
+            _ => {
+                exact_weight_scale_with(g, ConeModel::Circular, &d.wrench, Some(joints))?
+                    .weight_scale
+            }
+        };
+        out.scales.push(s);
+        out.margin = out.margin.min(s);
+        if s < 1.0 {
             out.failed = Some(i);
             break;
         }
@@ -211,6 +234,36 @@ pub fn hold_test(
         out.margin = 0.0;
     }
     Ok(out)
+}
+
+/// The closure verdict and, for a deciding test, the cheap test built on the
+/// squeeze of the reduced cones within the joints' torques. That squeeze, when
+/// strictly inside (as [`exact_force_closure_with`] requires) and of rank 6,
+/// is force closure of the unreduced grasp too (a smaller cone, fewer forces),
+/// so the closure program is solved only when it is not.
+fn closure(
+    grasp: &Grasp,
+    reduced: &Grasp,
+    joints: &JointTorques,
+    opts: &HoldOptions,
+) -> Result<(bool, Option<Superposition>), ExactError> {
+    let exact = |g: &Grasp| exact_force_closure_with(g, ConeModel::Circular, None);
+    if !opts.decide_only {
+        let fc = !opts.require_closure || exact(grasp)?.force_closure;
+        return Ok((fc, None));
+    }
+    let sq = exact_force_closure_with(reduced, ConeModel::Circular, Some(joints))?;
+    let f_min = grasp
+        .force_limits()
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let strict = sq.grasp_rank == 6 && sq.squeeze_margin > SQUEEZE_TOLERANCE * grasp.mu() * f_min;
+    let fc = !opts.require_closure || strict || exact(grasp)?.force_closure;
+    let fast = (sq.squeeze_margin > 0.0)
+        .then(|| Superposition::new(reduced, &sq.forces, Some(joints)))
+        .flatten();
+    Ok((fc, fast))
 }
 
 /// A squeeze: internal contact forces and the joint torques that make them.

@@ -110,6 +110,11 @@ impl JointTorques {
         self.jacobians.len()
     }
 
+    /// Contact `i`'s Jacobian (3 × m, world frame).
+    pub fn jacobian(&self, i: usize) -> &Matrix3xX<f64> {
+        &self.jacobians[i]
+    }
+
     /// The effort limits.
     pub fn efforts(&self) -> &[f64] {
         &self.efforts

@@ -13,6 +13,8 @@
 //! | [`exact`] | second-order cone programs (clarabel): exact closure, weight scale, forces | ~0.2 ms |
 //! | [`ferrari_canny`] | ε of the L1 and L∞ wrench spaces, 6-D hulls ([`hull`]: vendored Qhull) | ε_L1 ~3 ms, ε_L∞ seconds |
 //! | [`hold`] | closure + a disturbance set (±x/±y/±z weight, torques) with joint torque limits and a friction reserve; the squeeze | ~0.2 ms a disturbance |
+//! | [`stiffness`] | the grasp's 6×6 stiffness from servoed finger joints and pads; the object's motion under a load | a few µs |
+//! | [`superposition`] | a cheap sufficient test of one disturbance: a squeeze plus the least-norm forces | a few µs |
 //!
 //! Supporting modules: [`contact`] (contacts and contact frames `U_i`),
 //! [`grasp_matrix`] (eq. (6), `G` with torque scale `γ`), [`finger_force`]
@@ -57,3 +59,5 @@ pub mod grasp_matrix;
 pub mod hold;
 pub mod hull;
 pub mod joint_torques;
+pub mod stiffness;
+pub mod superposition;

@@ -459,6 +459,16 @@ pub struct HoldRequest {
     /// physics benchmark's grasps, 0.9 held 65 % (`docs/benchmarks.md`).
     #[serde(default = "default_squeeze_share")]
     pub squeeze_share: f64,
+    /// Largest turn (degrees) of the object under the six pulls of its
+    /// weight by the grasp's linear stiffness (servoed finger joints, pads;
+    /// `docs/force-closure.md`, "Stiffness"), standard set only (default
+    /// 1.2; above 0, at most 90).
+    #[serde(default = "default_max_turn")]
+    pub max_turn_deg: f64,
+    /// Largest shift (mm) of its centre of mass, likewise (default 1.5;
+    /// above 0, at most 100).
+    #[serde(default = "default_max_shift")]
+    pub max_shift_mm: f64,
     /// The object pose error the returned grasp is re-checked under
     /// (`docs/force-closure.md`, "Robust to the object's pose").
     #[serde(default)]
@@ -484,6 +494,12 @@ pub struct PoseError {
     pub samples: u32,
 }
 
+fn default_max_turn() -> f64 {
+    1.2
+}
+fn default_max_shift() -> f64 {
+    1.5
+}
 fn default_pose_shift() -> f64 {
     0.003
 }
@@ -521,6 +537,8 @@ impl Default for HoldRequest {
             com_error: default_com_error(),
             friction_reserve: default_friction_reserve(),
             squeeze_share: default_squeeze_share(),
+            max_turn_deg: default_max_turn(),
+            max_shift_mm: default_max_shift(),
             pose_error: PoseError::default(),
         }
     }
@@ -664,6 +682,20 @@ pub struct ForceClosureReply {
     /// (`HoldRequest::pose_error`).
     #[serde(default)]
     pub robustness: PoseRobustness,
+    /// How far the object moves in the hand under the six pulls of its
+    /// weight, the finger joints as servos and the contacts as pads
+    /// (`docs/force-closure.md`, "Stiffness"); absent when not computed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compliance: Option<HoldCompliance>,
+}
+
+/// The worst motion of the held object under the six pulls of its weight.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct HoldCompliance {
+    /// Largest turn, degrees.
+    pub turn_deg: f64,
+    /// Largest shift of the centre of mass, mm.
+    pub shift_mm: f64,
 }
 
 /// How many of the sampled object pose errors the grasp still holds under:
@@ -862,6 +894,10 @@ mod tests {
                     samples: 8,
                     held: 7,
                 },
+                compliance: Some(HoldCompliance {
+                    turn_deg: 2.5,
+                    shift_mm: 1.2,
+                }),
             },
             squeeze: vec![JointSqueeze {
                 joint: "r_index_j2".into(),

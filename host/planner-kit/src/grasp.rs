@@ -15,8 +15,8 @@ use nalgebra::{Point3, Vector3};
 use tsukami_body::kinematics::FkState;
 use tsukami_body::model::{JointId, LinkId};
 use tsukami_msgs::planner::{
-    BoxFace, ContactReply, FaceTilt, ForceClosureReply, GraspTypeRef, ObjectMass, PhaseTiming,
-    PlanReply,
+    BoxFace, ContactReply, FaceTilt, ForceClosureReply, GraspTypeRef, HoldCompliance, ObjectMass,
+    PhaseTiming, PlanReply,
 };
 
 use crate::planner::{GraspPlanner, World};
@@ -149,6 +149,10 @@ pub fn reply<P: GraspPlanner>(
             hold_margin: verdict.hold_margin,
             disturbances: verdict.disturbances,
             robustness: verdict.robustness,
+            compliance: verdict.compliance.map(|(t, s)| HoldCompliance {
+                turn_deg: t.to_degrees(),
+                shift_mm: s * 1e3,
+            }),
         },
         squeeze: verdict.squeeze.clone(),
         samples: run.samples,

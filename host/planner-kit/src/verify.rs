@@ -34,7 +34,9 @@ use tsukami_body::kinematics::FkState;
 use tsukami_body::model::LinkId;
 
 use crate::blocks::grasp_check::check_in;
-use crate::blocks::hold::{holds_under, squeeze, HoldContact, HoldProblem};
+use crate::blocks::hold::{
+    compliance, holds_exactly, holds_under, squeeze, HoldContact, HoldProblem,
+};
 use crate::blocks::robust::{pose_robustness, RobustProblem};
 use crate::blocks::wrap::{style_check, StyleRule};
 use crate::grasp::{FingerContact, Grasp};
@@ -68,6 +70,9 @@ pub struct Verdict {
     pub squeeze: Vec<JointSqueeze>,
     /// The hold test under the request's object pose errors ([`robustness`]).
     pub robustness: PoseRobustness,
+    /// The worst turn (rad) and shift (m) under the six pulls
+    /// ([`crate::blocks::hold::compliance`]).
+    pub compliance: Option<(f64, f64)>,
 }
 
 /// The paper's single maximum finger force of a contact set: the weakest `f_max`.
@@ -103,6 +108,7 @@ pub fn force_closure(object: &Object, contacts: &[FingerContact], length: f64) -
         disturbances: DisturbanceSet::Gravity,
         squeeze: Vec::new(),
         robustness: PoseRobustness::default(),
+        compliance: None,
     })
 }
 
@@ -204,6 +210,7 @@ fn hold_problem<'a, P: GraspPlanner>(
         mu: object.mu,
         com: object.center_of_mass,
         length,
+        servo_saturation: hand.servo_saturation,
     }
 }
 
@@ -322,7 +329,8 @@ fn hold_checks<P: GraspPlanner>(
     let problem = hold_problem(world, &fk, length);
     let contacts = hold_contacts(&grasp.contacts);
     style_check(&style_rule(world, grasp, &fk), &contacts)?;
-    let v = holds(world, &fk, &grasp.contacts, length, req)?;
+    let v = holds_exactly(&problem, &contacts, req)?;
+    verdict.compliance = compliance(&problem, &contacts);
     verdict.force_closure = v.force_closure;
     verdict.hold_margin = v.margin;
     verdict.disturbances = req.disturbances;

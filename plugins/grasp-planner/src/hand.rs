@@ -54,6 +54,8 @@ pub struct HandModel {
     pub contact_distance: f64,
     /// Cap on a finger's normal force (N), from the robot description.
     pub max_finger_force: f64,
+    /// Servo position error at full effort (rad or m), from the description.
+    pub servo_saturation: f64,
     /// Palm link.
     pub palm: LinkId,
     /// Arm joints.
@@ -119,6 +121,7 @@ impl HandModel {
             config: hand.grasp_types.clone(),
             contact_distance: hand.contact_distance,
             max_finger_force: hand.max_finger_force,
+            servo_saturation: hand.servo_saturation,
             palm: hand.palm,
             arm: hand.arm.clone(),
             wrist: hand.wrist.clone(),

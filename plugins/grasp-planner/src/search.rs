@@ -51,7 +51,7 @@ use tsukami_grasp::grasp::Grasp;
 use tsukami_grasp::grasp_matrix::Wrench;
 
 use tsukami_msgs::planner::{HoldRequest, PoseRobustness};
-use tsukami_planner_kit::blocks::hold::{hold, HoldContact, HoldProblem};
+use tsukami_planner_kit::blocks::hold::{holds_under, HoldContact, HoldProblem};
 use tsukami_planner_kit::blocks::wrap::{style_check, StyleRule};
 
 use crate::finger_closing::{close_fingers, FingerContact};
@@ -471,8 +471,9 @@ fn holds(ctx: &SearchContext<'_>, closed: &Closed<'_>) -> bool {
         mu: object.mu,
         com: object.center_of_mass,
         length: object.characteristic_length,
+        servo_saturation: hand.servo_saturation,
     };
-    hold(&problem, &hold_contacts(closed.contacts), &ctx.params.hold).is_some_and(|v| v.holds())
+    holds_under(&problem, &hold_contacts(closed.contacts), &ctx.params.hold).is_ok()
 }
 
 /// The samples of Algorithm 1 around one nominal pose: Δp_p (the palm),

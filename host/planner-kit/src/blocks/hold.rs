@@ -31,6 +31,7 @@ use tsukami_grasp::contact::Contact;
 use tsukami_grasp::grasp::Grasp;
 use tsukami_grasp::hold::{hold_test, Disturbances, HoldOptions, HoldVerdict};
 use tsukami_grasp::joint_torques::JointTorques;
+use tsukami_grasp::stiffness::GraspStiffness;
 use tsukami_msgs::planner::{DisturbanceSet, HoldRequest, JointSqueeze};
 
 use crate::blocks::force::hand_torques;
@@ -56,6 +57,9 @@ pub struct HoldProblem<'a> {
     pub com: Point3<f64>,
     /// Torque scale length, m.
     pub length: f64,
+    /// The hand's servo position error at full effort (rad or m): the
+    /// joints' stiffness is `effort / servo_saturation` ([`compliance`]).
+    pub servo_saturation: f64,
 }
 
 /// One contact as the hold test sees it: link, point and inward normal.
@@ -74,11 +78,12 @@ pub fn setup(p: &HoldProblem<'_>, contacts: &[HoldContact]) -> Option<(Grasp, Jo
     Some((grasp, torques))
 }
 
-/// The request's options as the grasp crate's.
+/// The request's options as the grasp crate's (exact margins).
 pub fn options(req: &HoldRequest) -> HoldOptions {
     HoldOptions {
         friction_reserve: req.friction_reserve,
         require_closure: req.disturbances == DisturbanceSet::Standard,
+        decide_only: false,
     }
 }
 
@@ -97,9 +102,22 @@ pub fn hold(
     contacts: &[HoldContact],
     req: &HoldRequest,
 ) -> Option<HoldVerdict> {
+    hold_with(p, contacts, req, false)
+}
+
+fn hold_with(
+    p: &HoldProblem<'_>,
+    contacts: &[HoldContact],
+    req: &HoldRequest,
+    decide_only: bool,
+) -> Option<HoldVerdict> {
     let (grasp, torques) = setup(p, contacts)?;
     let set = disturbances(p, &grasp, req);
-    hold_test(&grasp, &torques, &set, &options(req)).ok()
+    let opts = HoldOptions {
+        decide_only,
+        ..options(req)
+    };
+    hold_test(&grasp, &torques, &set, &opts).ok()
 }
 
 /// The squeeze of `contacts` at posture `q`: for every hand joint its torque
@@ -173,14 +191,58 @@ fn gap_motion(torques: &JointTorques, contacts: &[HoldContact], gaps: &[f64]) ->
     }
 }
 
-/// [`hold`] with the request's rule applied: closure when the set is the
-/// standard one, every disturbance balanced; the verdict or why not.
+/// The request's rule, decided: closure when the set is the standard one,
+/// every disturbance balanced; the verdict (its margins lower bounds:
+/// `tsukami_grasp::hold::HoldOptions::decide_only`, the same verdict as
+/// [`hold`]'s at a fraction of the cost) or why not. Searches call this.
 pub fn holds_under(
     p: &HoldProblem<'_>,
     contacts: &[HoldContact],
     req: &HoldRequest,
 ) -> Result<HoldVerdict, String> {
-    let v = hold(p, contacts, req).ok_or("the hold test could not be solved")?;
+    let v = rule(hold_with(p, contacts, req, true), req)?;
+    stiff_enough(p, contacts, req)?;
+    Ok(v)
+}
+
+/// [`holds_under`] with the exact margins (the reply's `hold_margin`).
+pub fn holds_exactly(
+    p: &HoldProblem<'_>,
+    contacts: &[HoldContact],
+    req: &HoldRequest,
+) -> Result<HoldVerdict, String> {
+    let v = rule(hold(p, contacts, req), req)?;
+    stiff_enough(p, contacts, req)?;
+    Ok(v)
+}
+
+/// With the standard set, the object may move under the six pulls of its
+/// weight at most the request's `max_turn_deg` and `max_shift_mm` by the
+/// linear stiffness model ([`compliance`]).
+fn stiff_enough(
+    p: &HoldProblem<'_>,
+    contacts: &[HoldContact],
+    req: &HoldRequest,
+) -> Result<(), String> {
+    if req.disturbances != DisturbanceSet::Standard {
+        return Ok(());
+    }
+    let (turn, shift) =
+        compliance(p, contacts).ok_or("some motion of the object is not resisted")?;
+    if turn.to_degrees() > req.max_turn_deg || shift * 1e3 > req.max_shift_mm {
+        return Err(format!(
+            "too compliant: the object turns {:.2}° and shifts {:.2} mm under its weight (at most {}° and {} mm)",
+            turn.to_degrees(),
+            shift * 1e3,
+            req.max_turn_deg,
+            req.max_shift_mm
+        ));
+    }
+    Ok(())
+}
+
+fn rule(v: Option<HoldVerdict>, req: &HoldRequest) -> Result<HoldVerdict, String> {
+    let v = v.ok_or("the hold test could not be solved")?;
     if req.disturbances == DisturbanceSet::Standard && !v.force_closure {
         return Err("the contacts are not in force closure".into());
     }
@@ -191,4 +253,38 @@ pub fn holds_under(
         ));
     }
     Ok(v)
+}
+
+/// Pad stiffness (N/m) of a contact, for [`compliance`].
+pub const PAD_STIFFNESS: f64 = 5000.0;
+
+/// How far the held object moves under the six pulls of its weight
+/// (±x, ±y, ±z at the centre of mass) with the finger joints as servos of
+/// stiffness `effort / servo_saturation` and pads of [`PAD_STIFFNESS`]
+/// (`tsukami_grasp::stiffness`): the largest turn (rad) and shift (m);
+/// `None` when some motion is not resisted at all.
+pub fn compliance(p: &HoldProblem<'_>, contacts: &[HoldContact]) -> Option<(f64, f64)> {
+    let servo_saturation = p.servo_saturation;
+    let (_, torques) = setup(p, contacts)?;
+    let points: Vec<Point3<f64>> = contacts.iter().map(|(_, x, _)| *x).collect();
+    let jac: Vec<_> = (0..points.len())
+        .map(|i| torques.jacobian(i).clone())
+        .collect();
+    let springs: Vec<f64> = torques
+        .efforts()
+        .iter()
+        .map(|e| (e / servo_saturation.max(1e-6)).max(1e-9))
+        .collect();
+    let k = GraspStiffness::new(&points, &p.com, &jac, &springs, PAD_STIFFNESS)?;
+    let (mut turn, mut shift) = (0.0f64, 0.0f64);
+    for axis in 0..3 {
+        for sign in [-1.0, 1.0] {
+            let mut w = tsukami_grasp::grasp_matrix::Wrench::zeros();
+            w[axis] = sign * p.mass * G;
+            let d = k.displacement(&w)?;
+            turn = turn.max(d.turn.norm());
+            shift = shift.max(d.shift.norm());
+        }
+    }
+    Some((turn, shift))
 }

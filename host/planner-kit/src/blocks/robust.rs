@@ -226,6 +226,7 @@ fn holds_moved(
         mu: p.object.mu,
         com,
         length: p.length,
+        servo_saturation: hand.servo_saturation,
     };
     holds_under(&problem, &moved, req).is_ok()
 }
