@@ -51,7 +51,7 @@ use tsukami_grasp::grasp::Grasp;
 use tsukami_grasp::grasp_matrix::Wrench;
 
 use tsukami_msgs::planner::{HoldRequest, PoseRobustness};
-use tsukami_planner_kit::blocks::hold::{holds_under, HoldContact, HoldProblem};
+use tsukami_planner_kit::blocks::hold::{holds_under, within_stiffness, HoldContact, HoldProblem};
 use tsukami_planner_kit::blocks::wrap::{style_check, StyleRule};
 
 use crate::finger_closing::{close_fingers, FingerContact};
@@ -139,6 +139,8 @@ pub struct Found {
     pub exact_ms: f64,
     /// Of the request's object pose errors, how many it still holds under.
     pub robustness: PoseRobustness,
+    /// Within the request's stiffness limits (`max_turn_deg`, `max_shift_mm`).
+    pub stiff: bool,
 }
 
 /// How a search ended.
@@ -155,7 +157,7 @@ pub enum Outcome {
 }
 
 /// The reasons a sample is rejected, in the order of [`Counters::rejections`].
-pub const REJECTION_REASONS: [&str; 8] = [
+pub const REJECTION_REASONS: [&str; 9] = [
     "ik",
     "collision before closing",
     "finger closing",
@@ -164,11 +166,11 @@ pub const REJECTION_REASONS: [&str; 8] = [
     "verification",
     "no wrap",
     "pose error",
+    "too compliant",
 ];
 
 /// Samples a search goes on drawing, after its first accepted grasp that
-/// some pose error drops, for one that holds under all of them; then the
-/// accepted grasp that held under the most is returned.
+/// some pose error drops or that is too compliant, for one that is neither.
 pub const ROBUST_EXTRA_SAMPLES: u32 = 48;
 
 /// The gap (m) a palm-contact grasp type leaves between palm and object
@@ -183,7 +185,7 @@ pub struct Counters {
     /// Best ellipsoid margin seen.
     pub best_margin: Option<f64>,
     /// Why samples were rejected, per [`REJECTION_REASONS`].
-    pub rejections: [u32; 8],
+    pub rejections: [u32; 9],
     /// What blocked the collision-rejected samples: `"<link> vs <obstacle>"`
     /// (or `"… vs <link>"` for self-collision) with counts.
     pub blockers: BTreeMap<String, u32>,
@@ -222,10 +224,11 @@ pub type Robustness<'h> = dyn FnMut(&Found) -> PoseRobustness + 'h;
 
 /// Algorithm 1 around one nominal pose. `q_nominal` is the nominal IK solution
 /// (full vector) for grasp type `t` over `stage`. The first accepted grasp
-/// that holds under every pose error is returned; one that some error drops
-/// is kept while the search goes on for at most [`ROBUST_EXTRA_SAMPLES`]
-/// samples, and the one that held under the most (the first of equals) is
-/// returned then.
+/// within the request's stiffness limits that holds under every pose error
+/// is returned; one that is not is kept while the search goes on for at most
+/// [`ROBUST_EXTRA_SAMPLES`] samples, and then the best kept is returned: a
+/// stiff one before a compliant one, then the one that held under the most
+/// pose errors (the first of equals).
 #[allow(clippy::too_many_arguments)]
 pub fn search(
     ctx: &SearchContext<'_>,
@@ -251,14 +254,16 @@ pub fn search(
                 robustness: r,
                 ..found
             });
-            if r.held == r.samples {
-                return Some(Outcome::Found(found));
+            match (found.stiff, r.held == r.samples) {
+                (true, true) => return Some(Outcome::Found(found)),
+                (false, _) => counters.reject(8, None),
+                (true, false) => counters.reject(7, None),
             }
-            counters.reject(7, None);
             if best.is_none() {
                 stop_at.set(at.saturating_add(ROBUST_EXTRA_SAMPLES));
             }
-            if best.as_ref().is_none_or(|b| r.held > b.robustness.held) {
+            let rank = |f: &Found| (f.stiff, f.robustness.held);
+            if best.as_ref().is_none_or(|b| rank(&found) > rank(b)) {
                 best = Some(found);
             }
             None
@@ -354,6 +359,8 @@ fn sample_loop(
         let Some(margin) = accept(ctx, &closed, counters, &mut exact_ms) else {
             continue;
         };
+        let stiff =
+            within_stiffness(&hold_problem(ctx, &fk), &hold_contacts(&contacts), &p.hold).is_ok();
         let found = Found {
             q: q.clone(),
             palm,
@@ -362,6 +369,7 @@ fn sample_loop(
             exact_resists_weight: true,
             exact_ms,
             robustness: PoseRobustness::default(),
+            stiff,
         };
         if let Some(done) = on_found(found, s, counters) {
             return done;
@@ -459,12 +467,12 @@ fn hold_contacts(contacts: &[FingerContact]) -> Vec<HoldContact> {
         .collect()
 }
 
-/// The kit's hold test on a closed hand (the rule the verification applies).
-fn holds(ctx: &SearchContext<'_>, closed: &Closed<'_>) -> bool {
+/// The kit's hold problem of the hand at posture `fk`.
+fn hold_problem<'a>(ctx: &'a SearchContext<'_>, fk: &'a FkState) -> HoldProblem<'a> {
     let (hand, object) = (ctx.hand, ctx.object);
-    let problem = HoldProblem {
+    HoldProblem {
         model: &hand.robot,
-        fk: closed.fk,
+        fk,
         joints: &hand.hand_joints,
         cap: hand.max_finger_force,
         mass: object.mass,
@@ -472,7 +480,12 @@ fn holds(ctx: &SearchContext<'_>, closed: &Closed<'_>) -> bool {
         com: object.center_of_mass,
         length: object.characteristic_length,
         servo_saturation: hand.servo_saturation,
-    };
+    }
+}
+
+/// The kit's hold test on a closed hand (the rule the verification applies).
+fn holds(ctx: &SearchContext<'_>, closed: &Closed<'_>) -> bool {
+    let problem = hold_problem(ctx, closed.fk);
     holds_under(&problem, &hold_contacts(closed.contacts), &ctx.params.hold).is_ok()
 }
 
