@@ -24,9 +24,8 @@ use tsukami_msgs::motion::JointTrajectory;
 use tsukami_msgs::planner::PlanReply;
 use tsukami_planner_kit::snapshot::Snapshot;
 use tsukami_planner_kit::Robot;
-
-use crate::drawing::{Drawing, Rgba};
-use crate::grasp_view::posture;
+use tsukami_render::drawing::{Drawing, Rgba};
+use tsukami_render::grasp_view::posture;
 use crate::latest::{Latest, Outcome};
 use crate::world::ViewerWorld;
 
