@@ -31,7 +31,6 @@ use tsukami_msgs::keys::{self, KeySpace};
 use tsukami_msgs::{ErrorCode, ErrorReply};
 use tsukami_plugin_api::loader::{LoadedLibrary, PluginInstance};
 use tsukami_plugin_api::INTERFACE_VERSION;
-use zenoh::bytes::Encoding;
 use zenoh::query::{Query, Queryable};
 use zenoh::Wait;
 

@@ -37,7 +37,13 @@ fn code(text: &str) -> String {
             (Some(open), semi) if semi.is_none_or(|s| open < s) => {
                 let mut depth = 0usize;
                 let close = rest[open..].char_indices().find(|&(_, c)| {
-                    depth = if c == '{' { depth + 1 } else if c == '}' { depth - 1 } else { depth };
+                    depth = if c == '{' {
+                        depth + 1
+                    } else if c == '}' {
+                        depth - 1
+                    } else {
+                        depth
+                    };
                     c == '}' && depth == 0
                 });
                 open + close.map_or(rest.len() - open, |(i, _)| i + 1)
@@ -76,8 +82,14 @@ fn modules(root: &Path) -> Modules {
     let mut todo = vec![(Vec::new(), root.to_owned())];
     while let Some((module, file)) = todo.pop() {
         let text = code(&std::fs::read_to_string(&file).expect("a source file"));
-        let own = file.file_name().is_some_and(|n| n == "mod.rs" || n == "main.rs" || n == "lib.rs");
-        let dir = if own { file.parent().unwrap().to_owned() } else { file.with_extension("") };
+        let own = file
+            .file_name()
+            .is_some_and(|n| n == "mod.rs" || n == "main.rs" || n == "lib.rs");
+        let dir = if own {
+            file.parent().unwrap().to_owned()
+        } else {
+            file.with_extension("")
+        };
         for (name, path) in declared(&text) {
             let child = match path {
                 Some(p) => file.parent().unwrap().join(p),
@@ -111,7 +123,9 @@ fn named(text: &str, module: &[String], children: &[String]) -> Vec<Vec<String>>
                 let base: Option<Vec<String>> = match first {
                     "crate" => Some(Vec::new()),
                     "super" => Some(module[..module.len().saturating_sub(1)].to_vec()),
-                    c if children.iter().any(|n| n == c) => Some([module, &[c.to_owned()]].concat()),
+                    c if children.iter().any(|n| n == c) => {
+                        Some([module, &[c.to_owned()]].concat())
+                    }
                     _ => None,
                 };
                 if let Some(base) = base {
@@ -144,7 +158,9 @@ fn tree(rest: &str, mut base: Vec<String>, out: &mut Vec<Vec<String>>) {
         }
         return;
     }
-    let end = rest.find(|c: char| !(c.is_alphanumeric() || c == '_')).unwrap_or(rest.len());
+    let end = rest
+        .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+        .unwrap_or(rest.len());
     let segment = &rest[..end];
     if segment == "super" {
         base.pop();
@@ -190,7 +206,12 @@ fn edges(src: &Path, root: &str) -> Vec<(String, String)> {
 
 /// The cycles among `edges`, each as its files in order.
 fn cycles(edges: &[(String, String)]) -> Vec<Vec<String>> {
-    fn walk(at: &str, edges: &[(String, String)], way: &mut Vec<String>, found: &mut Vec<Vec<String>>) {
+    fn walk(
+        at: &str,
+        edges: &[(String, String)],
+        way: &mut Vec<String>,
+        found: &mut Vec<Vec<String>>,
+    ) {
         if let Some(i) = way.iter().position(|f| f == at) {
             let mut cycle = way[i..].to_vec();
             let min = (0..cycle.len()).min_by_key(|&k| &cycle[k]).unwrap();
@@ -219,10 +240,20 @@ fn no_file_imports_a_file_that_imports_it_back() {
     let lib = edges(&src, "lib.rs");
     let bin = edges(&src, "main.rs");
     // The parser sees the imports that are there.
-    for edge in [("server.rs", "world.rs"), ("world.rs", "reply.rs"), ("demo/mod.rs", "demo/report.rs")] {
-        assert!(lib.contains(&(edge.0.into(), edge.1.into())), "missing edge {edge:?} in {lib:?}");
+    for edge in [
+        ("server.rs", "world.rs"),
+        ("world.rs", "reply.rs"),
+        ("demo/mod.rs", "demo/report.rs"),
+    ] {
+        assert!(
+            lib.contains(&(edge.0.into(), edge.1.into())),
+            "missing edge {edge:?} in {lib:?}"
+        );
     }
-    assert!(bin.contains(&("cli/fc.rs".into(), "cli/fc_problem.rs".into())), "{bin:?}");
+    assert!(
+        bin.contains(&("cli/fc.rs".into(), "cli/fc_problem.rs".into())),
+        "{bin:?}"
+    );
     let found: Vec<_> = cycles(&lib).into_iter().chain(cycles(&bin)).collect();
     assert!(found.is_empty(), "import cycles between files: {found:?}");
 }
@@ -230,10 +261,28 @@ fn no_file_imports_a_file_that_imports_it_back() {
 #[test]
 fn a_cycle_is_found() {
     let e = |a: &str, b: &str| (a.to_owned(), b.to_owned());
-    let found = cycles(&[e("a.rs", "b.rs"), e("b.rs", "c.rs"), e("c.rs", "a.rs"), e("c.rs", "d.rs")]);
-    assert_eq!(found, vec![vec!["a.rs".to_owned(), "b.rs".into(), "c.rs".into()]]);
+    let found = cycles(&[
+        e("a.rs", "b.rs"),
+        e("b.rs", "c.rs"),
+        e("c.rs", "a.rs"),
+        e("c.rs", "d.rs"),
+    ]);
+    assert_eq!(
+        found,
+        vec![vec!["a.rs".to_owned(), "b.rs".into(), "c.rs".into()]]
+    );
     let module = ["demo".to_owned(), "table".to_owned()];
-    let paths = named("use super::{step::{Step, X}, outcome::DemoScene};", &module, &[]);
-    assert!(paths.contains(&vec!["demo".into(), "step".into(), "Step".into()]), "{paths:?}");
-    assert!(paths.contains(&vec!["demo".into(), "outcome".into(), "DemoScene".into()]), "{paths:?}");
+    let paths = named(
+        "use super::{step::{Step, X}, outcome::DemoScene};",
+        &module,
+        &[],
+    );
+    assert!(
+        paths.contains(&vec!["demo".into(), "step".into(), "Step".into()]),
+        "{paths:?}"
+    );
+    assert!(
+        paths.contains(&vec!["demo".into(), "outcome".into(), "DemoScene".into()]),
+        "{paths:?}"
+    );
 }

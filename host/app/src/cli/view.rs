@@ -11,8 +11,8 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use nalgebra::Vector3;
 use tsukami::picture::write_pictures;
-use tsukami_render::grasp_view::DEFAULT_EYE;
 use tsukami_msgs::planner::PlanReply;
+use tsukami_render::grasp_view::DEFAULT_EYE;
 use tsukami_scenes::{scene_requests, World};
 
 /// Largest picture edge (pixels).

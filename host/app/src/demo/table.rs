@@ -7,8 +7,8 @@
 //!
 //! Why: the terminal table and the Markdown report show the same cells.
 
-use super::step::{Step, StepStatus};
 use super::outcome::DemoScene;
+use super::step::{Step, StepStatus};
 use crate::scenes::SceneOutcome;
 
 /// One scene's planning cells: grasp type, OCP region and face, whole-body
