@@ -17,7 +17,6 @@ use tsukami_grasp_planner::planner::Planner;
 use tsukami_msgs::planner::{PlanOptions, PlanReply};
 use tsukami_render::drawing::Drawing;
 use tsukami_render::glb::to_glb;
-use tsukami_render::grasp_view::{contact_marks, posture, GraspView};
 use tsukami_render::render::{render, Camera, Picture};
 use tsukami_scenes::{scene_requests, World};
 
@@ -43,18 +42,8 @@ fn can_breast() -> (PlanReply, World, Drawing) {
         )
         .unwrap();
     let world = World::from_requests(&models(), &req.robot, &req.object, &req.env).unwrap();
-    let q = posture(&world.robot.model, &reply).unwrap();
-    let contacts = contact_marks(&reply);
-    let drawing = GraspView {
-        model: &world.robot.model,
-        collision: &world.robot.collision,
-        q: &q,
-        hand_links: &world.robot.hand_links,
-        object: Some((&world.object.mesh, world.object.pose)),
-        obstacles: &world.obstacles,
-        contacts: &contacts,
-    }
-    .drawing();
+    // The drawing `tsukami view` and the demo's report make.
+    let drawing = tsukami::picture::scene_drawing(&world, Some(&reply)).unwrap();
     (reply, world, drawing)
 }
 

@@ -2,7 +2,7 @@
 //! the world hub ([`crate::world`]).
 //!
 //! What: [`reply_json`] and [`reply_error`] (the reply, or the error object,
-//! as JSON), [`check_payload`] (size, JSON syntax, an object at the top, before
+//! as JSON; the latter is `tsukami-bus`'s, as the components answer), [`check_payload`] (size, JSON syntax, an object at the top, before
 //! anything reaches a plugin) and [`ResultOut`] (a role's answers published
 //! after they are sent, for the result viewer).
 //!
@@ -21,6 +21,9 @@ use tsukami_msgs::{ErrorCode, ErrorReply};
 use zenoh::bytes::Encoding;
 use zenoh::query::Query;
 use zenoh::Wait;
+
+/// Answers `query` with the error object `error` (the components' own).
+pub(crate) use tsukami_bus::serve::reply_error;
 
 /// Where a role's answers are published after they are sent (`<ns>/<prefix>/result/<command>`,
 /// the reply's JSON or `{"error": …}`), so the result viewer follows plans it did not
@@ -53,18 +56,6 @@ pub(crate) fn reply_json(query: &Query, payload: Vec<u8>) {
         .wait()
     {
         tracing::warn!("reply on {} failed: {e}", query.key_expr());
-    }
-}
-
-/// Answers `query` with the error object `error`.
-pub(crate) fn reply_error(query: &Query, error: ErrorReply) {
-    tracing::debug!("error reply on {}: {error}", query.key_expr());
-    if let Err(e) = query
-        .reply_err(error.to_json_bytes())
-        .encoding(Encoding::APPLICATION_JSON)
-        .wait()
-    {
-        tracing::warn!("error reply on {} failed: {e}", query.key_expr());
     }
 }
 
