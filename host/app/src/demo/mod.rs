@@ -27,7 +27,7 @@
 //! afresh for each scene (the vision's camera renders one scene file; the
 //! controller starts at rest) and killed when it ends ([`children`]). Every
 //! request has a timeout. The files of the demo import downwards only: this
-//! root uses [`outcome`], [`table`], [`report`] and the steps' files; none of
+//! root uses [`outcome`], `table`, [`report`] and the steps' files; none of
 //! them imports this file (`host/app/tests/module_cycles.rs` checks).
 
 pub mod children;
