@@ -1,9 +1,12 @@
 //! Time to plan each of the paper's scenes, p50 over seeds, in-process (the plugin
 //! file cargo built, loaded into this process and called through its FFI with a
 //! recording host: no bus) and over the bus (a client → the host → the same plugin
-//! file), in the same run, with the ratio. (Linking the planner's library here
-//! instead would put two plugins' root-module exports in one binary: the host's
-//! picture code links the result viewer's.)
+//! file), in the same run, with the ratio. The in-process side calls the plugin
+//! file, not the planner's library, so both sides run the same code through the
+//! same boundary and the ratio is the bus's cost alone. (Linking the library
+//! is possible since the host's pictures moved to `host/render`: the host links
+//! no plugin crate, so only the planner's root-module export would be in the
+//! binary; see `docs/plugins.md`, "A plugin is loaded, never linked".)
 //!
 //! Run: `cargo bench -p tsukami-e2e --bench plan_scenes`. Targets (issue #5): can at
 //! breast height p50 < 10 ms in-process; fridge scene p50 < 100 ms.

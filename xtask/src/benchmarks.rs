@@ -2,7 +2,8 @@
 //! writes what they print into `docs/benchmarks.md`.
 //!
 //! What: every bench target (and the example that prints the object
-//! benchmark) in [`BENCHES`] is run in turn; its standard output replaces the
+//! benchmark, the physics subset `bench/physics/ci.sh` and the clean build
+//! `bench/build_time.sh`) in [`BENCHES`] is run in turn; its standard output replaces the
 //! fenced block between `<!-- bench-output NAME -->` and
 //! `<!-- /bench-output -->` in the page, and the block between `<!-- machine -->`
 //! and `<!-- /machine -->` is replaced by this machine's description (CPU,
@@ -12,34 +13,47 @@
 //! The prose around each block (what is measured, targets, analysis) stays
 //! written by people; the numbers come from one command.
 //!
-//! How: `cargo bench`/`cargo run --release` as child processes, output
+//! How: `cargo bench`/`cargo run --release` (or `bash` for a script) as child processes, output
 //! captured, each block headed by the machine line; a bench that fails leaves its block saying so (with its exit
 //! status) and the command goes on with the others, then exits non-zero.
 
 use std::path::Path;
 use std::process::Command;
 
-/// One bench: its block name in the page and the cargo arguments that run it.
+/// One bench: its block name in the page and the command that runs it.
 pub struct Bench {
     /// The block's name (`<!-- bench-output NAME -->`).
     pub name: &'static str,
-    /// Arguments after `cargo`.
+    /// The program: `cargo` (this cargo), or `bash` for a script of `bench/`.
+    pub program: &'static str,
+    /// Its arguments (after `cargo`, or the script and its own).
     pub args: &'static [&'static str],
+}
+
+impl Bench {
+    /// The command line, as the page and `--list` show it.
+    pub fn command_line(&self) -> String {
+        format!("{} {}", self.program, self.args.join(" "))
+    }
 }
 
 /// Every bench target whose output the page holds, in page order.
 #[rustfmt::skip]
 pub const BENCHES: &[Bench] = &[
-    Bench { name: "roundtrip", args: &["bench", "-p", "tsukami-e2e", "--bench", "roundtrip"] },
-    Bench { name: "viewer", args: &["bench", "-p", "tsukami-e2e", "--bench", "viewer"] },
-    Bench { name: "body", args: &["bench", "-p", "tsukami-body", "--bench", "body", "--", "--warm-up-time", "1", "--measurement-time", "3"] },
-    Bench { name: "force_closure", args: &["bench", "-p", "tsukami-grasp", "--bench", "force_closure", "--", "--warm-up-time", "1", "--measurement-time", "3"] },
-    Bench { name: "fc_default", args: &["bench", "-p", "tsukami", "--bench", "fc_default"] },
-    Bench { name: "plan_scenes", args: &["bench", "-p", "tsukami-e2e", "--bench", "plan_scenes"] },
-    Bench { name: "concurrency", args: &["bench", "-p", "tsukami-e2e", "--bench", "concurrency"] },
-    Bench { name: "object_bench", args: &["run", "--release", "-p", "tsukami-grasp-planner", "--example", "object_bench"] },
-    Bench { name: "motion_scenes", args: &["bench", "-p", "tsukami-trajectory-planner", "--bench", "motion_scenes"] },
-    Bench { name: "vision", args: &["bench", "-p", "tsukami-vision", "--bench", "vision"] },
+    Bench { name: "roundtrip", program: "cargo", args: &["bench", "-p", "tsukami-e2e", "--bench", "roundtrip"] },
+    Bench { name: "viewer", program: "cargo", args: &["bench", "-p", "tsukami-e2e", "--bench", "viewer"] },
+    Bench { name: "body", program: "cargo", args: &["bench", "-p", "tsukami-body", "--bench", "body", "--", "--warm-up-time", "1", "--measurement-time", "3"] },
+    Bench { name: "force_closure", program: "cargo", args: &["bench", "-p", "tsukami-grasp", "--bench", "force_closure", "--", "--warm-up-time", "1", "--measurement-time", "3"] },
+    Bench { name: "fc_default", program: "cargo", args: &["bench", "-p", "tsukami", "--bench", "fc_default"] },
+    Bench { name: "plan_scenes", program: "cargo", args: &["bench", "-p", "tsukami-e2e", "--bench", "plan_scenes"] },
+    Bench { name: "plan_scenes_in_process", program: "cargo", args: &["bench", "-p", "tsukami-grasp-planner", "--bench", "plan_scenes", "--", "--warm-up-time", "1", "--measurement-time", "3"] },
+    Bench { name: "antipodal_plan_can", program: "cargo", args: &["bench", "-p", "tsukami-antipodal-planner", "--bench", "plan_can", "--", "--warm-up-time", "1", "--measurement-time", "3"] },
+    Bench { name: "concurrency", program: "cargo", args: &["bench", "-p", "tsukami-e2e", "--bench", "concurrency"] },
+    Bench { name: "object_bench", program: "cargo", args: &["run", "--release", "-p", "tsukami-grasp-planner", "--example", "object_bench"] },
+    Bench { name: "physics", program: "bash", args: &["bench/physics/ci.sh"] },
+    Bench { name: "motion_scenes", program: "cargo", args: &["bench", "-p", "tsukami-trajectory-planner", "--bench", "motion_scenes"] },
+    Bench { name: "vision", program: "cargo", args: &["bench", "-p", "tsukami-vision", "--bench", "vision"] },
+    Bench { name: "build_time", program: "bash", args: &["bench/build_time.sh"] },
 ];
 
 /// Runs the chosen benches (all when `only` is empty) and rewrites `page`.
@@ -67,8 +81,16 @@ pub fn run(root: &Path, only: &[String]) -> Result<(), String> {
         .iter()
         .filter(|b| only.is_empty() || only.iter().any(|n| n == b.name))
     {
-        eprintln!("== {}: cargo {}", b.name, b.args.join(" "));
-        let out = Command::new(&cargo).args(b.args).current_dir(root).output();
+        eprintln!("== {}: {}", b.name, b.command_line());
+        let program: &str = if b.program == "cargo" {
+            &cargo
+        } else {
+            b.program
+        };
+        let out = Command::new(program)
+            .args(b.args)
+            .current_dir(root)
+            .output();
         let text = match out {
             Ok(o) if o.status.success() => without_noise(&String::from_utf8_lossy(&o.stdout)),
             Ok(o) => {
@@ -86,8 +108,8 @@ pub fn run(root: &Path, only: &[String]) -> Result<(), String> {
         };
         let open = format!("<!-- bench-output {} -->", b.name);
         let block = format!(
-            "```text\n# {machine}\n$ cargo {}\n{}```",
-            b.args.join(" "),
+            "```text\n# {machine}\n$ {}\n{}```",
+            b.command_line(),
             ensure_newline(&text)
         );
         update(&page_path, &open, "<!-- /bench-output -->", &block)?;
@@ -215,6 +237,52 @@ mod tests {
     fn criterion_outlier_lists_are_dropped() {
         let out = "g/a\n   time: [1 ns 2 ns 3 ns]\nFound 2 outliers among 100 measurements (2.00%)\n  1 (1.00%) high mild\n  1 (1.00%) low severe\nnext\n";
         assert_eq!(without_noise(out), "g/a\n   time: [1 ns 2 ns 3 ns]\nnext\n");
+    }
+
+    #[test]
+    fn every_section_has_a_block_and_every_block_a_bench() {
+        let page = include_str!("../../docs/benchmarks.md");
+        for section in page.split("\n## ").skip(1) {
+            let title = section.lines().next().unwrap_or_default();
+            assert!(
+                section.contains("<!-- bench-output "),
+                "docs/benchmarks.md: section `{title}` has no `<!-- bench-output NAME -->` block"
+            );
+        }
+        for block in page.split("<!-- bench-output ").skip(1) {
+            let name = block.split(" -->").next().unwrap_or_default();
+            assert!(
+                BENCHES.iter().any(|b| b.name == name),
+                "docs/benchmarks.md: block `{name}` is no bench of BENCHES"
+            );
+        }
+    }
+
+    #[test]
+    fn every_bench_target_of_the_workspace_is_run() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let workspace: toml::Table = std::fs::read_to_string(root.join("Cargo.toml"))
+            .unwrap()
+            .parse()
+            .unwrap();
+        let members = workspace["workspace"]["members"].as_array().unwrap();
+        for member in members.iter().filter_map(|m| m.as_str()) {
+            let manifest: toml::Table =
+                std::fs::read_to_string(root.join(member).join("Cargo.toml"))
+                    .unwrap()
+                    .parse()
+                    .unwrap();
+            let package = manifest["package"]["name"].as_str().unwrap();
+            let benches = manifest.get("bench").and_then(|b| b.as_array());
+            for bench in benches.into_iter().flatten() {
+                let name = bench["name"].as_str().unwrap();
+                let run = BENCHES.iter().any(|b| {
+                    b.args.windows(2).any(|w| w == ["-p", package])
+                        && b.args.windows(2).any(|w| w == ["--bench", name])
+                });
+                assert!(run, "bench {package}/{name} is in no entry of BENCHES");
+            }
+        }
     }
 
     #[test]

@@ -58,7 +58,7 @@ fn run_release(subcommand: &str, rest: &[String]) -> ExitCode {
 fn run_benchmarks(rest: &[String]) -> ExitCode {
     if rest.iter().any(|a| a == "--list") {
         for b in benchmarks::BENCHES {
-            println!("{:<14} cargo {}", b.name, b.args.join(" "));
+            println!("{:<24} {}", b.name, b.command_line());
         }
         return ExitCode::SUCCESS;
     }

@@ -9,18 +9,25 @@
 //!   hands in a zenoh config file of their own.
 //! - [`server`]: loads the plugins, owns the one zenoh session, routes each role's
 //!   queries to its plugin on a worker thread, answers `stop` and `host/plugins`.
+//! - `reply`: answering a query (JSON reply, error object, payload check),
+//!   shared by the server and the world hub.
+//! - [`world`]: the one world every world-aware plugin shares.
 //! - [`host_handle`]: what a plugin reaches the bus through.
 //! - [`demo`]: `tsukami demo`, the main job.
 //! - [`scenes`]: the paper's scenes run over the bus and judged.
 //! - [`client`]: a small blocking client for the bus (CLI, demo, tests, benches).
+//! - [`picture`]: `tsukami view`'s and the report's pictures, drawn by `tsukami-render`.
+//!
+//! No file here imports a file that imports it back (`tests/module_cycles.rs`
+//! checks every `use crate::…` and `super::…` path).
 
 pub mod bus;
 pub mod client;
 pub mod config;
 pub mod demo;
-pub mod demo_report;
 pub mod host_handle;
 pub mod picture;
+mod reply;
 pub mod scenes;
 pub mod server;
 pub mod world;

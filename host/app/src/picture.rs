@@ -1,21 +1,18 @@
 //! Pictures of a scene and its planned grasp, for `tsukami view` and the
-//! demo's report: a PNG from the result viewer's software renderer and,
-//! optionally, the same drawing as a glTF binary.
+//! demo's report: a PNG from the software renderer of `tsukami-render` (the
+//! host library the result-viewer plugin draws with too) and, optionally, the
+//! same drawing as a glTF binary.
 
 use std::path::Path;
 
 use anyhow::{Context, Result};
 use nalgebra::{Point3, Vector3};
 use tsukami_msgs::planner::PlanReply;
-use tsukami_result_viewer::drawing::Drawing;
-use tsukami_result_viewer::glb::to_glb;
-use tsukami_result_viewer::grasp_view::{self, contact_marks, posture, GraspView};
-use tsukami_result_viewer::render::{render, Camera};
+use tsukami_render::drawing::Drawing;
+use tsukami_render::glb::to_glb;
+use tsukami_render::grasp_view::{self, contact_marks, posture, GraspView};
+use tsukami_render::render::{render, Camera};
 use tsukami_scenes::World;
-
-/// Where the camera sits relative to the object by default (m, world frame):
-/// to the robot's right, in front, a little above.
-pub const DEFAULT_EYE: [f64; 3] = [0.15, -0.55, 0.25];
 
 /// The drawing of `world` with the robot at `reply`'s posture and its
 /// contacts, or at rest without a reply.
@@ -56,7 +53,7 @@ pub fn write_pictures(
 ) -> Result<usize> {
     let drawing = scene_drawing(world, reply)?;
     let target = look_at(world, reply);
-    let camera = Camera::looking_at(target + eye, target, Vector3::z());
+    let camera = Camera::offset_from(target, eye);
     let picture = render(&drawing, &camera, size.0, size.1).to_png()?;
     std::fs::write(png, picture).with_context(|| format!("writing {}", png.display()))?;
     if let Some(path) = glb {

@@ -17,10 +17,10 @@
 
 use crate::config::HostConfig;
 use crate::host_handle::BusHost;
+use crate::reply::{check_payload, reply_error, reply_json, ResultOut};
 use crate::world::WorldHub;
 use anyhow::{bail, Context, Result};
 use std::borrow::Cow;
-use std::io::Read;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::sync::{Arc, Mutex, Weak};
@@ -31,7 +31,6 @@ use tsukami_msgs::keys::{self, KeySpace};
 use tsukami_msgs::{ErrorCode, ErrorReply};
 use tsukami_plugin_api::loader::{LoadedLibrary, PluginInstance};
 use tsukami_plugin_api::INTERFACE_VERSION;
-use zenoh::bytes::Encoding;
 use zenoh::query::{Query, Queryable};
 use zenoh::Wait;
 
@@ -61,27 +60,6 @@ struct Worker {
     /// The other workers' calls (a `concurrent` plugin with several workers).
     more: Vec<Arc<Mutex<CurrentCall>>>,
     world: Option<Arc<WorldHub>>,
-}
-
-/// Where a role's answers are published after they are sent (`<ns>/<prefix>/result/<command>`,
-/// the reply's JSON or `{"error": …}`), so the result viewer follows plans it did not
-/// ask for. zenoh's default for a put drops rather than waits on congestion: never
-/// delays the worker.
-pub(crate) struct ResultOut {
-    pub(crate) session: zenoh::Session,
-    pub(crate) keys: KeySpace,
-    /// The role (or `world`) whose prefix the results go under.
-    pub(crate) role: String,
-}
-
-impl ResultOut {
-    pub(crate) fn publish(&self, command: &str, bytes: Vec<u8>) {
-        let key = self.keys.command(&self.role, &format!("result/{command}"));
-        let put = self.session.put(&key, bytes);
-        if let Err(e) = put.encoding(Encoding::APPLICATION_JSON).wait() {
-            tracing::debug!("result not published on {key}: {e}");
-        }
-    }
 }
 
 /// How often the watchdog looks at the running call.
@@ -136,81 +114,6 @@ pub struct RunningHost {
     plugins: PluginsReply,
     queryables: Vec<Queryable<()>>,
     workers: Vec<JoinHandle<()>>,
-}
-
-pub(crate) fn reply_json(query: &Query, payload: Vec<u8>) {
-    if let Err(e) = query
-        .reply(query.key_expr().clone(), payload)
-        .encoding(Encoding::APPLICATION_JSON)
-        .wait()
-    {
-        tracing::warn!("reply on {} failed: {e}", query.key_expr());
-    }
-}
-
-pub(crate) fn reply_error(query: &Query, error: ErrorReply) {
-    tracing::debug!("error reply on {}: {error}", query.key_expr());
-    if let Err(e) = query
-        .reply_err(error.to_json_bytes())
-        .encoding(Encoding::APPLICATION_JSON)
-        .wait()
-    {
-        tracing::warn!("error reply on {} failed: {e}", query.key_expr());
-    }
-}
-
-/// Checks a request before it reaches a plugin: size, JSON syntax, and a JSON
-/// object at the top (every command takes one). An empty or all-blank payload
-/// stands for `{}`. The payload is read in place, not copied.
-pub(crate) fn check_payload(query: &Query, max_bytes: usize) -> Result<(), ErrorReply> {
-    let Some(payload) = query.payload() else {
-        return Ok(());
-    };
-    if payload.len() > max_bytes {
-        return Err(ErrorReply::new(
-            ErrorCode::PayloadTooLarge,
-            format!(
-                "payload is {} bytes; this host accepts at most {max_bytes}",
-                payload.len()
-            ),
-        ));
-    }
-    check_json_object(std::io::BufReader::with_capacity(
-        64 * 1024,
-        payload.reader(),
-    ))
-}
-
-/// `Ok` for blank input or one JSON object; `malformed_json` for anything that is
-/// not JSON, `invalid_request` for JSON that is not an object.
-fn check_json_object(mut reader: impl Read) -> Result<(), ErrorReply> {
-    let malformed = |e: &dyn std::fmt::Display| {
-        ErrorReply::new(
-            ErrorCode::MalformedJson,
-            format!("payload is not valid JSON: {e}"),
-        )
-    };
-    let mut first = [0u8; 1];
-    loop {
-        match reader.read(&mut first) {
-            Ok(0) => return Ok(()),
-            Ok(_) if first[0].is_ascii_whitespace() => continue,
-            Ok(_) => break,
-            Err(e) => return Err(malformed(&e)),
-        }
-    }
-    let mut json = serde_json::Deserializer::from_reader(std::io::Cursor::new(first).chain(reader));
-    serde::de::Deserialize::deserialize(&mut json)
-        .map(|_: serde::de::IgnoredAny| ())
-        .and_then(|()| json.end())
-        .map_err(|e| malformed(&e))?;
-    if first[0] != b'{' {
-        return Err(ErrorReply::new(
-            ErrorCode::InvalidRequest,
-            "the payload must be a JSON object (`{...}`); an empty payload stands for `{}`",
-        ));
-    }
-    Ok(())
 }
 
 /// The payload a plugin gets: the query's bytes (borrowed when zenoh holds them

@@ -33,7 +33,7 @@ use tsukami_plugin_api::CallError;
 use zenoh::query::{Query, Queryable};
 use zenoh::Wait;
 
-use crate::server::{check_payload, reply_error, reply_json, ResultOut};
+use crate::reply::{check_payload, reply_error, reply_json, ResultOut};
 
 /// A plugin that shares the world.
 pub struct Member {

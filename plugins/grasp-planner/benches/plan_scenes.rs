@@ -23,7 +23,7 @@ const SCENES: [&str; 5] = [
 fn planner(scene: &str) -> Planner {
     let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
     let req = scene_requests(&models.join("scenes").join(format!("{scene}.toml"))).unwrap();
-    let mut p = Planner::new(&models);
+    let p = Planner::new(&models);
     p.set_robot(&req.robot).unwrap();
     p.set_object(&req.object).unwrap();
     p.set_env(&req.env).unwrap();
@@ -78,7 +78,7 @@ fn stop_latency() {
     let mut worst: f64 = 0.0;
     let mut all = Vec::new();
     for k in 0..20 {
-        let mut p = planner("fridge_pet");
+        let p = planner("fridge_pet");
         let cancel = AtomicBool::new(false);
         let stopped_at = std::sync::Mutex::new(None::<Instant>);
         std::thread::scope(|s| {

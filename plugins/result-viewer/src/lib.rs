@@ -1,44 +1,32 @@
-//! Tsukami's result viewer: what a planned grasp looks like.
+//! Tsukami's result viewer: the `result-viewer` plugin.
 //!
-//! What: a [`drawing::Drawing`] — coloured triangle groups (robot links at the
-//! planned posture, the object, the obstacles, contact markers and friction
-//! cones) — built by [`grasp_view::GraspView`], and two ways out of it: a PNG
-//! picture from a software z-buffer renderer ([`render`]) and a glTF 2.0
-//! binary (`.glb`, [`glb`]) that opens in any 3D tool.
+//! What: the plugin ([`plugin`]) shares the host's world ([`world`]), follows
+//! plan and motion results on the bus ([`follow`], into [`latest`]), answers
+//! `render` (PNG) and `glb` from them ([`viewer`]) and serves a live three.js
+//! view of them on loopback ([`web`], with the page's JSON from [`scene`]).
 //!
 //! Why: a person judges a grasp by looking at it (Choreonoid shows the result
-//! in its graphics window). A robot PC is often headless: the picture needs no
-//! browser, no GPU and no display; the `.glb` carries the same scene to a
-//! desktop.
+//! in its graphics window); a headless robot PC needs the same from a browser,
+//! a picture or a file, without slowing the planners (the viewer only
+//! listens).
 //!
-//! How: shapes are tessellated once into world-frame triangles with a flat
-//! colour per group; the renderer projects them through a pinhole
-//! [`render::Camera`] into a depth buffer with Lambert shading; the glTF
-//! writer puts one mesh and one node per group into a single binary buffer.
-//!
-//! As the `result-viewer` plugin ([`plugin`]) it shares the host's world,
-//! follows plan and motion results on the bus ([`follow`]) and serves a live
-//! three.js view of them on loopback ([`web`]).
+//! How: the drawing itself — tessellation, the software renderer, the glTF
+//! writer, the grasp scene — is the host library `tsukami-render`
+//! (`host/render`), which `tsukami view` and the demo's report use too; this
+//! crate holds only what makes it a plugin: the bus, the web server and the
+//! FFI export.
 //!
 //! ```
-//! use nalgebra::{Point3, Vector3};
-//! use tsukami_result_viewer::drawing::{Drawing, Rgba};
-//! use tsukami_result_viewer::render::{render, Camera};
-//! let mut d = Drawing::default();
-//! d.marker("contact", Rgba::CONTACT, &Point3::new(0.0, 0.0, 0.0), 0.01);
-//! let camera = Camera::looking_at(Point3::new(0.3, 0.0, 0.1), Point3::origin(), Vector3::z());
-//! let picture = render(&d, &camera, 64, 48);
-//! assert_ne!(picture.pixel(32, 24), picture.background);
-//! assert!(picture.to_png().unwrap().starts_with(b"\x89PNG"));
+//! use tsukami_result_viewer::latest::{Board, Outcome};
+//! let board = Board::default();
+//! let g = board.generation();
+//! board.update(|l| l.plan = Some(Outcome::Failed("infeasible: no grasp".into()).into()));
+//! assert_eq!(board.generation(), g + 1);
 //! ```
 
-pub mod drawing;
 pub mod follow;
-pub mod glb;
-pub mod grasp_view;
 pub mod latest;
 pub mod plugin;
-pub mod render;
 pub mod scene;
 pub mod viewer;
 pub mod web;

@@ -34,9 +34,10 @@ use tsukami_msgs::error::parse_request;
 use tsukami_msgs::keys::{world, ROLE_RESULT_VIEWER};
 use tsukami_planner_kit::PlannerConfig;
 use tsukami_plugin_api::{CallContext, CallError, Host, LogLevel, Plugin, PluginInfo};
+use tsukami_render::grasp_view::DEFAULT_EYE;
 
 use crate::latest::Board;
-use crate::viewer::{Viewer, DEFAULT_EYE};
+use crate::viewer::Viewer;
 use crate::web::WebServer;
 use crate::world::ViewerWorld;
 

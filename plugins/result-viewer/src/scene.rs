@@ -15,6 +15,8 @@
 //! `f32` arrays; poses are `[x, y, z, qx, qy, qz, qw]` in the world frame
 //! (z up, the robot's `base_link`), from forward kinematics.
 
+use crate::latest::{Latest, Outcome};
+use crate::world::ViewerWorld;
 use nalgebra::Isometry3;
 use serde::Serialize;
 use serde_json::{json, Value};
@@ -24,11 +26,8 @@ use tsukami_msgs::motion::JointTrajectory;
 use tsukami_msgs::planner::PlanReply;
 use tsukami_planner_kit::snapshot::Snapshot;
 use tsukami_planner_kit::Robot;
-
-use crate::drawing::{Drawing, Rgba};
-use crate::grasp_view::posture;
-use crate::latest::{Latest, Outcome};
-use crate::world::ViewerWorld;
+use tsukami_render::drawing::{Drawing, Rgba};
+use tsukami_render::grasp_view::posture;
 
 /// Most frames of a trajectory sent to the page.
 pub const MAX_FRAMES: usize = 120;

@@ -23,16 +23,13 @@ use tsukami_body::collision::CollisionObject;
 use tsukami_planner_kit::snapshot::Snapshot;
 use tsukami_planner_kit::Session;
 
-use crate::drawing::Drawing;
-use crate::glb::to_glb;
-use crate::grasp_view::{contact_marks, look_at, posture, GraspView};
-use crate::latest::{Board, Outcome};
-use crate::render::{render, Camera};
-use crate::world::ViewerWorld;
+use tsukami_render::drawing::Drawing;
+use tsukami_render::glb::to_glb;
+use tsukami_render::grasp_view::{contact_marks, look_at, posture, GraspView};
+use tsukami_render::render::{render, Camera};
 
-/// Where a picture's camera sits relative to what it looks at by default (m,
-/// world frame): to the robot's right, in front, a little above.
-pub const DEFAULT_EYE: [f64; 3] = [0.15, -0.55, 0.25];
+use crate::latest::{Board, Outcome};
+use crate::world::ViewerWorld;
 
 /// A cached product and the key it was made for.
 type Cached = Mutex<Option<((u64, u64), Arc<Vec<u8>>)>>;
@@ -170,7 +167,7 @@ impl Viewer {
     pub fn render(&self, width: u32, height: u32, eye: Vector3<f64>) -> Result<Picture, String> {
         let world = self.session.snapshot();
         let (drawing, posture, target) = self.drawing(&world)?;
-        let camera = Camera::looking_at(target + eye, target, Vector3::z());
+        let camera = Camera::offset_from(target, eye);
         let png = render(&drawing, &camera, width, height)
             .to_png()
             .map_err(|e| format!("internal: encoding the PNG: {e}"))?;

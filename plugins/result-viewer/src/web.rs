@@ -70,7 +70,7 @@ fn bind(addr: SocketAddr, fallback: bool) -> io::Result<TcpListener> {
 }
 
 impl WebServer {
-    /// Starts serving `viewer` on `addr` (see [`bind`] for `fallback`).
+    /// Starts serving `viewer` on `addr` (see `bind` for `fallback`).
     pub fn start(
         addr: SocketAddr,
         fallback: bool,

@@ -3,15 +3,16 @@
 //!
 //! The scene file (`models/scenes/*.toml`) gives the robot, the object and the
 //! obstacles; the result is a Plan reply (`tsukami plan … > reply.json`). The
-//! picture comes from the result viewer's software renderer.
+//! picture comes from the software renderer of `tsukami-render`.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use nalgebra::Vector3;
-use tsukami::picture::{write_pictures, DEFAULT_EYE};
+use tsukami::picture::write_pictures;
 use tsukami_msgs::planner::PlanReply;
+use tsukami_render::grasp_view::DEFAULT_EYE;
 use tsukami_scenes::{scene_requests, World};
 
 /// Largest picture edge (pixels).
@@ -37,7 +38,7 @@ pub struct ViewArgs {
     size: String,
     /// Camera position relative to the object (m, world frame), `x,y,z`; it
     /// looks at the object. Default: to the robot's right, in front, above
-    /// (`tsukami::picture::DEFAULT_EYE`).
+    /// (`tsukami_render::grasp_view::DEFAULT_EYE`).
     #[arg(long, allow_hyphen_values = true)]
     eye: Option<String>,
 }

@@ -7,8 +7,8 @@
 //!
 //! Why: the terminal table and the Markdown report show the same cells.
 
+use super::outcome::DemoScene;
 use super::step::{Step, StepStatus};
-use super::DemoScene;
 use crate::scenes::SceneOutcome;
 
 /// One scene's planning cells: grasp type, OCP region and face, whole-body
@@ -141,7 +141,7 @@ pub fn notes(s: &DemoScene) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::demo::PlanOn;
+    use crate::demo::outcome::PlanOn;
 
     fn scene() -> DemoScene {
         DemoScene {

@@ -12,7 +12,7 @@ use tsukami_msgs::planner::PlanOptions;
 fn planner_for(scene: &str) -> AntipodalPlanner {
     let models = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../models");
     let req = tsukami_scenes::scene_requests(&models.join("scenes").join(scene)).expect("scene");
-    let mut p = AntipodalPlanner::new(models);
+    let p = AntipodalPlanner::new(models);
     p.set_robot(&req.robot).expect("robot");
     p.set_object(&req.object).expect("object");
     p.set_env(&req.env).expect("env");

@@ -1,16 +1,28 @@
-//! The demo's report: a Markdown page with one row and one picture per scene,
-//! beside each scene's picture (`SCENE.png`) and glTF binary (`SCENE.glb`); the
-//! components' logs are in `logs/` beside them.
+//! The demo's report: a Markdown page with one row and one picture per scene.
+//!
+//! What: [`write_report`] writes `report.md` beside each scene's picture
+//! (`SCENE.png`) and glTF binary (`SCENE.glb`); the components' logs are in
+//! `logs/` beside them.
+//!
+//! Why: the terminal table scrolls away; the report keeps the same cells with
+//! a picture of every grasp, for a person to look at later.
+//!
+//! How: the cells come from the table's functions (the same as printed); each
+//! scene's world is loaded again from its scene file and drawn with
+//! `tsukami-render` through [`crate::picture`].
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use nalgebra::Vector3;
+
+use tsukami_render::grasp_view::DEFAULT_EYE;
 use tsukami_scenes::{scene_requests, World};
 
-use crate::demo::{notes, plan_cells, step_cells, DemoScene, PlanOn};
-use crate::picture::{write_pictures, DEFAULT_EYE};
+use super::outcome::{DemoScene, PlanOn};
+use super::table::{notes, plan_cells, step_cells};
+use crate::picture::write_pictures;
 
 /// Picture size of the report (pixels).
 const PICTURE: (u32, u32) = (800, 600);

@@ -58,7 +58,7 @@ pub fn to_glb(drawing: &Drawing) -> Vec<u8> {
             .map(|(i, g)| json!({"name": g.name, "mesh": i})),
     );
     let mut document = json!({
-        "asset": {"version": "2.0", "generator": concat!("tsukami-result-viewer ", env!("CARGO_PKG_VERSION"))},
+        "asset": {"version": "2.0", "generator": concat!("tsukami-render ", env!("CARGO_PKG_VERSION"))},
         "scene": 0,
         "scenes": [{"name": "grasp", "nodes": [0]}],
         "nodes": nodes,

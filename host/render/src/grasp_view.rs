@@ -20,6 +20,10 @@ use tsukami_msgs::planner::PlanReply;
 
 use crate::drawing::{Drawing, Rgba};
 
+/// Where a grasp picture's camera sits relative to what it looks at by
+/// default (m, world frame): to the robot's right, in front, a little above.
+pub const DEFAULT_EYE: [f64; 3] = [0.15, -0.55, 0.25];
+
 /// Radius of a contact marker (m).
 pub const CONTACT_RADIUS: f64 = 0.006;
 /// Height of a friction cone (m).

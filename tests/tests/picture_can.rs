@@ -2,6 +2,11 @@
 //! planned by the built-in planner: the picture shows the hand, the can and
 //! the contact markers where they project; the `.glb` is structurally valid
 //! glTF 2.0 (header, chunks, accessors against buffer views, node tree).
+//!
+//! The drawing is the host library `tsukami-render`; the grasp needs the
+//! paper's planner, linked here as a library (the one plugin crate this test
+//! links), so the test lives with the end-to-end tests rather than in
+//! `host/render`, whose manifest names no plugin crate.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -10,17 +15,16 @@ use nalgebra::{Point3, Vector3};
 use serde_json::Value;
 use tsukami_grasp_planner::planner::Planner;
 use tsukami_msgs::planner::{PlanOptions, PlanReply};
-use tsukami_result_viewer::drawing::Drawing;
-use tsukami_result_viewer::glb::to_glb;
-use tsukami_result_viewer::grasp_view::{contact_marks, posture, GraspView};
-use tsukami_result_viewer::render::{render, Camera, Picture};
+use tsukami_render::drawing::Drawing;
+use tsukami_render::glb::to_glb;
+use tsukami_render::render::{render, Camera, Picture};
 use tsukami_scenes::{scene_requests, World};
 
 const W: u32 = 480;
 const H: u32 = 360;
 
 fn models() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../models")
 }
 
 /// The planned can grasp, its world and its drawing.
@@ -38,18 +42,8 @@ fn can_breast() -> (PlanReply, World, Drawing) {
         )
         .unwrap();
     let world = World::from_requests(&models(), &req.robot, &req.object, &req.env).unwrap();
-    let q = posture(&world.robot.model, &reply).unwrap();
-    let contacts = contact_marks(&reply);
-    let drawing = GraspView {
-        model: &world.robot.model,
-        collision: &world.robot.collision,
-        q: &q,
-        hand_links: &world.robot.hand_links,
-        object: Some((&world.object.mesh, world.object.pose)),
-        obstacles: &world.obstacles,
-        contacts: &contacts,
-    }
-    .drawing();
+    // The drawing `tsukami view` and the demo's report make.
+    let drawing = tsukami::picture::scene_drawing(&world, Some(&reply)).unwrap();
     (reply, world, drawing)
 }
 

@@ -13,7 +13,7 @@
 //!
 //! ```
 //! use nalgebra::{Point3, Vector3};
-//! use tsukami_result_viewer::drawing::{Drawing, Rgba};
+//! use tsukami_render::drawing::{Drawing, Rgba};
 //! let mut d = Drawing::default();
 //! d.cone("cone", Rgba::CONE, &Point3::origin(), &Vector3::z(), 0.3, 0.02);
 //! let (lo, hi) = d.bounds().unwrap();

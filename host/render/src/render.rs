@@ -47,6 +47,13 @@ impl Camera {
         }
     }
 
+    /// A camera at `target + offset` looking at `target`, world z up (a
+    /// grasp picture: `offset` is [`crate::grasp_view::DEFAULT_EYE`] unless
+    /// the user moves it).
+    pub fn offset_from(target: Point3<f64>, offset: Vector3<f64>) -> Self {
+        Self::looking_at(target + offset, target, Vector3::z())
+    }
+
     /// A camera looking along `direction` at the centre of the box
     /// `lo`–`hi`, far enough back for the whole box to fit (world z up).
     pub fn framing(lo: &Point3<f64>, hi: &Point3<f64>, direction: &Vector3<f64>) -> Self {

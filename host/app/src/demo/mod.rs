@@ -26,35 +26,39 @@
 //! reach both (zenoh peers do not forward for each other). Components are started
 //! afresh for each scene (the vision's camera renders one scene file; the
 //! controller starts at rest) and killed when it ends ([`children`]). Every
-//! request has a timeout.
+//! request has a timeout. The files of the demo import downwards only: this
+//! root uses [`outcome`], `table`, [`report`] and the steps' files; none of
+//! them imports this file (`host/app/tests/module_cycles.rs` checks).
 
 pub mod children;
 pub mod motion;
+pub mod outcome;
+pub mod report;
 mod status;
 pub mod step;
 mod table;
 pub mod vision;
 
-pub(crate) use table::{notes, plan_cells, step_cells};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context, Result};
+use tsukami_msgs::host::PluginsReply;
+use tsukami_msgs::keys::{ROLE_RESULT_VIEWER, ROLE_TRAJECTORY_PLANNER};
+use tsukami_msgs::planner::ObjectShape;
+use tsukami_scenes::{scene_requests, PaperScene, PAPER_SCENES};
 
 use crate::bus::{free_loopback_port, BusConfig};
 use crate::client::BusClient;
 use crate::config::{default_models_dir, HostConfig};
 use crate::scenes::{run_scene_at, SceneOutcome};
 use crate::server::RunningHost;
-use anyhow::{bail, Context, Result};
 use children::{locate, ComponentProcess, Supervisor};
 use motion::{ExecutionRun, MotionCheck};
-use serde::Serialize;
+pub use outcome::{DemoScene, PlanOn};
 use status::Status;
-use std::path::{Path, PathBuf};
-use std::process::ExitCode;
-use std::time::{Duration, Instant};
 use step::{Step, StepStatus};
-use tsukami_msgs::host::PluginsReply;
-use tsukami_msgs::keys::{ROLE_RESULT_VIEWER, ROLE_TRAJECTORY_PLANNER};
-use tsukami_msgs::planner::ObjectShape;
-use tsukami_scenes::{scene_requests, PaperScene, PAPER_SCENES};
 use vision::VisionCheck;
 
 /// Options of `tsukami demo`.
@@ -103,16 +107,6 @@ impl Default for DemoArgs {
     }
 }
 
-/// Which object pose a grasp is planned on.
-#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PlanOn {
-    /// The scene file's (the truth).
-    Scene,
-    /// The vision component's estimate.
-    Vision,
-}
-
 /// Where the report goes without `--out`.
 pub const DEFAULT_REPORT_DIR: &str = "target/demo-report";
 
@@ -125,29 +119,6 @@ const CONTROLLER_STATE_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// How long a component may take to answer on the bus after it was started.
 const COMPONENT_READY: Duration = Duration::from_secs(60);
-
-/// What happened to one scene.
-#[derive(Debug, Clone, Serialize)]
-pub struct DemoScene {
-    /// The grasp, judged against the paper (`scene`, `expected`, `ok`, `result`, …).
-    #[serde(flatten)]
-    pub plan: SceneOutcome,
-    /// The object pose the grasp was planned on.
-    pub planned_on: PlanOn,
-    /// The vision component's pose against the scene's.
-    pub vision: Step<VisionCheck>,
-    /// The trajectory planner's motion to the grasp and the lift.
-    pub motion: Step<MotionCheck>,
-    /// The controller's run of that motion.
-    pub execution: Step<ExecutionRun>,
-}
-
-impl DemoScene {
-    /// The paper's outcome, and the motion planned and executed (or not run).
-    pub fn passed(&self) -> bool {
-        self.plan.ok && !self.motion.failed_to_run() && !self.execution.failed_to_run()
-    }
-}
 
 /// Runs the demo.
 pub fn run(args: &DemoArgs) -> Result<ExitCode> {
@@ -214,7 +185,7 @@ pub fn run(args: &DemoArgs) -> Result<ExitCode> {
     }
     demo.client.close();
     host.shutdown();
-    let report = crate::demo_report::write_report(&out, &demo.models, &results, args.seed)?;
+    let report = report::write_report(&out, &demo.models, &results, args.seed)?;
     if !args.json {
         println!(
             "\nReport, pictures, .glb files and the components' logs: {}",
