@@ -237,19 +237,29 @@ fn bad_env_and_options_are_refused() {
         .unwrap_err();
     assert_eq!(e.reason(), "bad_value");
 
-    for (pose_error, field) in [
-        (r#"{"samples": 65}"#, "hold.pose_error.samples"),
-        (r#"{"position": -0.001}"#, "hold.pose_error.position"),
-        (r#"{"rotation_deg": 45}"#, "hold.pose_error.rotation_deg"),
+    for (hold, field) in [
+        (
+            r#""pose_error": {"samples": 65}"#,
+            "hold.pose_error.samples",
+        ),
+        (
+            r#""pose_error": {"position": -0.001}"#,
+            "hold.pose_error.position",
+        ),
+        (
+            r#""pose_error": {"rotation_deg": 45}"#,
+            "hold.pose_error.rotation_deg",
+        ),
+        (r#""max_turn_deg": 0"#, "hold.max_turn_deg"),
+        (r#""max_shift_mm": 1e9"#, "hold.max_shift_mm"),
     ] {
         let opts: PlanOptions =
-            serde_json::from_str(&format!(r#"{{"hold": {{"pose_error": {pose_error}}}}}"#))
-                .unwrap();
+            serde_json::from_str(&format!(r#"{{"hold": {{{hold}}}}}"#)).unwrap();
         let e = p
             .plan(&opts, &AtomicBool::new(false), &mut |_| {})
             .unwrap_err();
-        assert_eq!(e.reason(), "bad_value", "{pose_error}");
-        assert!(e.to_string().contains(field), "{pose_error}: {e}");
+        assert_eq!(e.reason(), "bad_value", "{hold}");
+        assert!(e.to_string().contains(field), "{hold}: {e}");
     }
 }
 
