@@ -461,14 +461,14 @@ pub struct HoldRequest {
     pub squeeze_share: f64,
     /// Largest turn (degrees) of the object under the six pulls of its
     /// weight by the grasp's linear stiffness (servoed finger joints, pads;
-    /// `docs/force-closure.md`, "Stiffness"), standard set only (default
-    /// 1.2; above 0, at most 90).
-    #[serde(default = "default_max_turn")]
-    pub max_turn_deg: f64,
-    /// Largest shift (mm) of its centre of mass, likewise (default 1.5;
+    /// `docs/force-closure.md`, "Stiffness"): a grasp beyond it is refused,
+    /// with the standard set only. Off by default; above 0, at most 90.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_turn_deg: Option<f64>,
+    /// Largest shift (mm) of its centre of mass, likewise (off by default;
     /// above 0, at most 100).
-    #[serde(default = "default_max_shift")]
-    pub max_shift_mm: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_shift_mm: Option<f64>,
     /// The object pose error the returned grasp is re-checked under
     /// (`docs/force-closure.md`, "Robust to the object's pose").
     #[serde(default)]
@@ -494,12 +494,6 @@ pub struct PoseError {
     pub samples: u32,
 }
 
-fn default_max_turn() -> f64 {
-    1.2
-}
-fn default_max_shift() -> f64 {
-    1.5
-}
 fn default_pose_shift() -> f64 {
     0.003
 }
@@ -537,8 +531,8 @@ impl Default for HoldRequest {
             com_error: default_com_error(),
             friction_reserve: default_friction_reserve(),
             squeeze_share: default_squeeze_share(),
-            max_turn_deg: default_max_turn(),
-            max_shift_mm: default_max_shift(),
+            max_turn_deg: None,
+            max_shift_mm: None,
             pose_error: PoseError::default(),
         }
     }

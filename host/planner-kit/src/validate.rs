@@ -227,8 +227,12 @@ pub fn hold_request(h: &tsukami_msgs::planner::HoldRequest) -> Result<(), KitErr
     ranged(h.com_error, "com_error", 0.0, 0.2, false)?;
     ranged(h.friction_reserve, "friction_reserve", 0.0, 0.9, false)?;
     ranged(h.squeeze_share, "squeeze_share", 0.0, 1.0, true)?;
-    ranged(h.max_turn_deg, "max_turn_deg", 0.0, 90.0, true)?;
-    ranged(h.max_shift_mm, "max_shift_mm", 0.0, 100.0, true)?;
+    if let Some(t) = h.max_turn_deg {
+        ranged(t, "max_turn_deg", 0.0, 90.0, true)?;
+    }
+    if let Some(s) = h.max_shift_mm {
+        ranged(s, "max_shift_mm", 0.0, 100.0, true)?;
+    }
     let e = &h.pose_error;
     ranged(e.position, "pose_error.position", 0.0, 0.05, false)?;
     ranged(e.rotation_deg, "pose_error.rotation_deg", 0.0, 30.0, false)?;

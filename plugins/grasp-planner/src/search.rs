@@ -51,7 +51,7 @@ use tsukami_grasp::grasp::Grasp;
 use tsukami_grasp::grasp_matrix::Wrench;
 
 use tsukami_msgs::planner::{HoldRequest, PoseRobustness};
-use tsukami_planner_kit::blocks::hold::{holds_under, within_stiffness, HoldContact, HoldProblem};
+use tsukami_planner_kit::blocks::hold::{holds_under, HoldContact, HoldProblem};
 use tsukami_planner_kit::blocks::wrap::{style_check, StyleRule};
 
 use crate::finger_closing::{close_fingers, FingerContact};
@@ -139,8 +139,6 @@ pub struct Found {
     pub exact_ms: f64,
     /// Of the request's object pose errors, how many it still holds under.
     pub robustness: PoseRobustness,
-    /// Within the request's stiffness limits (`max_turn_deg`, `max_shift_mm`).
-    pub stiff: bool,
 }
 
 /// How a search ended.
@@ -170,7 +168,7 @@ pub const REJECTION_REASONS: [&str; 9] = [
 ];
 
 /// Samples a search goes on drawing, after its first accepted grasp that
-/// some pose error drops or that is too compliant, for one that is neither.
+/// some pose error drops, for one that holds under all of them.
 pub const ROBUST_EXTRA_SAMPLES: u32 = 48;
 
 /// The gap (m) a palm-contact grasp type leaves between palm and object
@@ -224,11 +222,10 @@ pub type Robustness<'h> = dyn FnMut(&Found) -> PoseRobustness + 'h;
 
 /// Algorithm 1 around one nominal pose. `q_nominal` is the nominal IK solution
 /// (full vector) for grasp type `t` over `stage`. The first accepted grasp
-/// within the request's stiffness limits that holds under every pose error
-/// is returned; one that is not is kept while the search goes on for at most
-/// [`ROBUST_EXTRA_SAMPLES`] samples, and then the best kept is returned: a
-/// stiff one before a compliant one, then the one that held under the most
-/// pose errors (the first of equals).
+/// that holds under every pose error is returned; one that some error drops
+/// is kept while the search goes on for at most [`ROBUST_EXTRA_SAMPLES`]
+/// samples, and the one that held under the most (the first of equals) is
+/// returned then.
 #[allow(clippy::too_many_arguments)]
 pub fn search(
     ctx: &SearchContext<'_>,
@@ -254,16 +251,14 @@ pub fn search(
                 robustness: r,
                 ..found
             });
-            match (found.stiff, r.held == r.samples) {
-                (true, true) => return Some(Outcome::Found(found)),
-                (false, _) => counters.reject(8, None),
-                (true, false) => counters.reject(7, None),
+            if r.held == r.samples {
+                return Some(Outcome::Found(found));
             }
+            counters.reject(7, None);
             if best.is_none() {
                 stop_at.set(at.saturating_add(ROBUST_EXTRA_SAMPLES));
             }
-            let rank = |f: &Found| (f.stiff, f.robustness.held);
-            if best.as_ref().is_none_or(|b| rank(&found) > rank(b)) {
+            if best.as_ref().is_none_or(|b| r.held > b.robustness.held) {
                 best = Some(found);
             }
             None
@@ -359,8 +354,6 @@ fn sample_loop(
         let Some(margin) = accept(ctx, &closed, counters, &mut exact_ms) else {
             continue;
         };
-        let stiff =
-            within_stiffness(&hold_problem(ctx, &fk), &hold_contacts(&contacts), &p.hold).is_ok();
         let found = Found {
             q: q.clone(),
             palm,
@@ -369,7 +362,6 @@ fn sample_loop(
             exact_resists_weight: true,
             exact_ms,
             robustness: PoseRobustness::default(),
-            stiff,
         };
         if let Some(done) = on_found(found, s, counters) {
             return done;
@@ -430,10 +422,20 @@ fn accept(
         return None;
     }
     let t_exact = Instant::now();
-    let exact = exact_resists(ctx.object, &grasp, 1.0, &mut counters.hints) && holds(ctx, closed);
+    let exact = match exact_resists(ctx.object, &grasp, 1.0, &mut counters.hints) {
+        true => holds(ctx, closed),
+        false => Err(String::new()),
+    };
     *exact_ms += t_exact.elapsed().as_secs_f64() * 1e3;
-    if !exact {
-        counters.reject(4, None);
+    if let Err(why) = exact {
+        counters.reject(
+            if why.starts_with("too compliant") {
+                8
+            } else {
+                4
+            },
+            None,
+        );
         return None;
     }
     Some(margin)
@@ -484,9 +486,9 @@ fn hold_problem<'a>(ctx: &'a SearchContext<'_>, fk: &'a FkState) -> HoldProblem<
 }
 
 /// The kit's hold test on a closed hand (the rule the verification applies).
-fn holds(ctx: &SearchContext<'_>, closed: &Closed<'_>) -> bool {
+fn holds(ctx: &SearchContext<'_>, closed: &Closed<'_>) -> Result<(), String> {
     let problem = hold_problem(ctx, closed.fk);
-    holds_under(&problem, &hold_contacts(closed.contacts), &ctx.params.hold).is_ok()
+    holds_under(&problem, &hold_contacts(closed.contacts), &ctx.params.hold).map(|_| ())
 }
 
 /// The samples of Algorithm 1 around one nominal pose: Δp_p (the palm),

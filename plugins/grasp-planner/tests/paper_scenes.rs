@@ -248,3 +248,26 @@ fn a_large_pose_error_drops_the_grasp() {
     assert!(rb.held < 8, "{rb:?}");
     assert!(r.samples > 1, "the search went on for a robust grasp");
 }
+
+/// The reply states the stiffness model's worst turn and shift; a request
+/// that limits them gets a grasp within them (the search and the
+/// verification apply the same rule), or none.
+#[test]
+fn a_stiffness_limit_is_kept_by_the_returned_grasp() {
+    let (mut p, _) = setup("can_waist");
+    let free = plan(&mut p, &seeded(0)).unwrap();
+    let c = free.force_closure.compliance.expect("compliance reported");
+    assert!(c.turn_deg > 1.2, "the paper's pinch is compliant: {c:?}");
+    let opts = PlanOptions {
+        hold: tsukami_msgs::planner::HoldRequest {
+            max_turn_deg: Some(1.2),
+            max_shift_mm: Some(1.5),
+            ..Default::default()
+        },
+        ..seeded(0)
+    };
+    let r = plan(&mut p, &opts).unwrap();
+    let c = r.force_closure.compliance.expect("compliance reported");
+    assert!(c.turn_deg <= 1.2 && c.shift_mm <= 1.5, "{c:?}");
+    assert_grasp_holds("can_waist", &r);
+}

@@ -200,7 +200,9 @@ pub fn holds_under(
     contacts: &[HoldContact],
     req: &HoldRequest,
 ) -> Result<HoldVerdict, String> {
-    rule(hold_with(p, contacts, req, true), req)
+    let v = rule(hold_with(p, contacts, req, true), req)?;
+    within_stiffness(p, contacts, req)?;
+    Ok(v)
 }
 
 /// [`holds_under`] with the exact margins (the reply's `hold_margin`).
@@ -209,31 +211,36 @@ pub fn holds_exactly(
     contacts: &[HoldContact],
     req: &HoldRequest,
 ) -> Result<HoldVerdict, String> {
-    rule(hold(p, contacts, req), req)
+    let v = rule(hold(p, contacts, req), req)?;
+    within_stiffness(p, contacts, req)?;
+    Ok(v)
 }
 
 /// Whether the object moves under the six pulls of its weight at most the
 /// request's `max_turn_deg` and `max_shift_mm` by the linear stiffness model
-/// ([`compliance`]); always with the gravity set (the paper's test). A
-/// preference: searches prefer grasps within it, the verification reports
-/// the figures and does not refuse.
+/// ([`compliance`]), when the request sets them; always with the gravity
+/// set (the paper's test). Part of [`holds_under`] and [`holds_exactly`].
 pub fn within_stiffness(
     p: &HoldProblem<'_>,
     contacts: &[HoldContact],
     req: &HoldRequest,
 ) -> Result<(), String> {
-    if req.disturbances != DisturbanceSet::Standard {
+    let (max_turn, max_shift) = (
+        req.max_turn_deg.unwrap_or(f64::INFINITY),
+        req.max_shift_mm.unwrap_or(f64::INFINITY),
+    );
+    if req.disturbances != DisturbanceSet::Standard
+        || (max_turn, max_shift) == (f64::INFINITY, f64::INFINITY)
+    {
         return Ok(());
     }
-    let (turn, shift) =
-        compliance(p, contacts).ok_or("some motion of the object is not resisted")?;
-    if turn.to_degrees() > req.max_turn_deg || shift * 1e3 > req.max_shift_mm {
+    let (turn, shift) = compliance(p, contacts)
+        .ok_or("too compliant: some motion of the object is not resisted")?;
+    if turn.to_degrees() > max_turn || shift * 1e3 > max_shift {
         return Err(format!(
-            "too compliant: the object turns {:.2}° and shifts {:.2} mm under its weight (at most {}° and {} mm)",
+            "too compliant: the object turns {:.2}° and shifts {:.2} mm under its weight (at most {max_turn}° and {max_shift} mm)",
             turn.to_degrees(),
             shift * 1e3,
-            req.max_turn_deg,
-            req.max_shift_mm
         ));
     }
     Ok(())
