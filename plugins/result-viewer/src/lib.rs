@@ -40,6 +40,7 @@ pub mod latest;
 pub mod plugin;
 pub mod render;
 pub mod scene;
+mod unread;
 pub mod viewer;
 pub mod web;
 pub mod world;
