@@ -1,6 +1,8 @@
 //! Plans per second with 1, 2 and 4 concurrent clients against a host whose
 //! planner has a pool of 1, 2 and 4 workers, on the paper's can scene
-//! (`can_breast`), over the bus; the ratio to the pool of 1 is printed. Then,
+//! (`can_breast`), over the bus; the ratio to the pool of 1 is printed; then the
+//! 4-client / 1-client ratio of the host's default config (a pool of one worker
+//! per core). Then,
 //! when `TSUKAMI_BEFORE` names the `tsukami` binary of an older build (with its
 //! planner plugin beside it and `TSUKAMI_BEFORE_MODELS` its models folder),
 //! plan p50 over the bus per paper scene, that build against this one, in the
@@ -124,6 +126,21 @@ fn pool_table() {
     }
 }
 
+/// The host's default config (the planner's pool: one worker per core): 4
+/// clients' throughput over 1 client's.
+fn default_ratio() {
+    let workers = tsukami::world::default_workers();
+    let bus = TestBus::start(test_config(vec![planner_entry()]));
+    set_scene(&bus.client, &models_dir(), "can_breast");
+    assert!(plan(&bus.client, 0).1, "can_breast plans");
+    let (one, four) = (throughput(&bus, 1), throughput(&bus, 4));
+    println!(
+        "default config (pool = {workers}, the cores): 1 client {one:.1} plans/s, 4 clients \
+         {four:.1} plans/s: 4 / 1 = {:.2}x",
+        four / one
+    );
+}
+
 /// p50 per scene over the bus against an older build's host process.
 fn before_after(before: &str, before_models: &str) {
     let port = free_loopback_port().unwrap();
@@ -180,6 +197,7 @@ fn before_after(before: &str, before_models: &str) {
 
 fn main() {
     pool_table();
+    default_ratio();
     match (
         std::env::var("TSUKAMI_BEFORE"),
         std::env::var("TSUKAMI_BEFORE_MODELS"),

@@ -21,6 +21,7 @@
 //! [[plugin]]
 //! role = "grasp-planner"
 //! library = "tsukami_grasp_planner"   # platform prefix/extension added; or `path = "…/libx.so"`
+//! # workers = 2                       # calls at once (`concurrent` plugins); default: the cores
 //! [plugin.config]                     # handed to the plugin as TOML text
 //! models_dir = "../models"
 //! ```
@@ -164,8 +165,10 @@ pub struct PluginEntryConfig {
     /// The plugin's own config, handed to it as TOML text.
     #[serde(default)]
     pub config: Option<toml::Table>,
-    /// Calls the host runs at once for this plugin (its worker pool; default
-    /// 1). Used only if the plugin declares the `concurrent` capability.
+    /// Calls the host runs at once for this plugin (its worker pool; default:
+    /// the machine's cores, `std::thread::available_parallelism`, at most 64).
+    /// Used only if the plugin declares the `concurrent` capability; others get
+    /// one worker.
     #[serde(default)]
     pub workers: Option<usize>,
 }

@@ -7,6 +7,7 @@
 use abi_stable::sabi_trait::TD_Opaque;
 use abi_stable::std_types::{RArc, RBox, ROption, RResult, RSlice, RStr, RString, RVec};
 use std::time::Duration;
+use tsukami_bus::RequestError;
 use tsukami_msgs::{ErrorCode, ErrorReply, KeySpace};
 use tsukami_plugin_api::ffi::{
     FfiCallError, FfiHost, FfiHostBox, FfiHost_TO, FfiSample, FfiSubscription, FfiSubscriptionBox,
@@ -49,14 +50,8 @@ impl BusHost {
     }
 }
 
-/// Turns an error reply's payload into the FFI error, keeping its code.
-pub fn call_error_from_reply(payload: &[u8]) -> FfiCallError {
-    let reply = serde_json::from_slice::<ErrorReply>(payload).unwrap_or_else(|_| {
-        ErrorReply::new(
-            ErrorCode::Internal,
-            String::from_utf8_lossy(payload).into_owned(),
-        )
-    });
+/// The FFI error of an error object, keeping its code and details.
+fn call_error(reply: ErrorReply) -> FfiCallError {
     FfiCallError {
         code: reply.error.code.as_str().into(),
         message: reply.error.message.as_str().into(),
@@ -95,30 +90,19 @@ impl FfiHost for BusHost {
         timeout_ms: u64,
     ) -> RResult<RVec<u8>, FfiCallError> {
         let key = self.keys.key(key.as_str());
-        let replies = match self
-            .session
-            .get(&key)
-            .payload(payload.as_slice().to_vec())
-            .encoding(Encoding::APPLICATION_JSON)
-            .timeout(Duration::from_millis(timeout_ms))
-            .wait()
-        {
-            Ok(replies) => replies,
-            Err(e) => {
-                return RResult::RErr(ffi_error(
-                    ErrorCode::Internal,
-                    format!("querying {key}: {e}"),
-                ))
+        let timeout = Duration::from_millis(timeout_ms);
+        match tsukami_bus::client::query(&self.session, &key, payload.as_slice(), timeout) {
+            Ok(bytes) => RResult::ROk(RVec::from(bytes)),
+            Err(RequestError::Reply(reply) | RequestError::Conflict(reply)) => {
+                RResult::RErr(call_error(reply))
             }
-        };
-        match replies.recv() {
-            Ok(reply) => match reply.result() {
-                Ok(sample) => RResult::ROk(RVec::from(sample.payload().to_bytes().into_owned())),
-                Err(err) => RResult::RErr(call_error_from_reply(&err.payload().to_bytes())),
-            },
-            Err(_) => RResult::RErr(ffi_error(
+            Err(RequestError::Timeout { .. }) => RResult::RErr(ffi_error(
                 ErrorCode::Timeout,
                 format!("no reply from {key} within {timeout_ms} ms"),
+            )),
+            Err(RequestError::Bus { message, .. }) => RResult::RErr(ffi_error(
+                ErrorCode::Internal,
+                format!("querying {key}: {message}"),
             )),
         }
     }

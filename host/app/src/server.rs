@@ -466,9 +466,9 @@ impl RunningHost {
     /// fills, an unknown role, an absent component: answered with `no_plugin`
     /// naming the role (`details.role`); a garbage payload still gets
     /// `malformed_json` / `invalid_request`. A served prefix is left to its own
-    /// queryable. Declared not complete, so that where a component serves its own
-    /// `<prefix>/stop` as a complete queryable (as `tsukami_bus::Component` does),
-    /// zenoh's default query target (best matching) sends the query there only.
+    /// queryable. Declared not complete. Where a component serves its own
+    /// `<prefix>/stop`, Tsukami's callers (target `All`) get both answers and keep
+    /// the component's: a `no_plugin` stands aside (`tsukami_bus::client::query`).
     fn answer_stop_without_plugin(
         session: &zenoh::Session,
         keys: &KeySpace,

@@ -270,17 +270,23 @@ impl Drop for WorldHub {
     }
 }
 
-/// The worker count of a plugin: its config's `workers` if it declares
-/// `concurrent`, else 1.
+/// The worker count of a plugin: if it declares `concurrent`, its config's
+/// `workers` or else [`default_workers`] (at most 64); otherwise 1.
 pub fn workers_for(
     entry: &crate::config::PluginEntryConfig,
     info: &tsukami_plugin_api::PluginInfo,
 ) -> usize {
     if info.has(tsukami_plugin_api::PluginInfo::CONCURRENT) {
-        entry.workers.unwrap_or(1).clamp(1, 64)
+        entry.workers.unwrap_or_else(default_workers).clamp(1, 64)
     } else {
         1
     }
+}
+
+/// A concurrent plugin's pool when its config names none: one worker per core
+/// the process may use (1 when that cannot be told).
+pub fn default_workers() -> usize {
+    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
 }
 
 /// A plugin as the server created it.
@@ -319,4 +325,26 @@ pub fn start(
     let hub = Arc::new(WorldHub::start(members, config.limits.max_queue, results)?);
     queryables.push(hub.serve_keys(session, keys, config.limits.max_payload_bytes)?);
     Ok(Some(hub))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tsukami_plugin_api::PluginInfo;
+
+    #[test]
+    fn concurrent_plugins_get_the_cores_unless_configured() {
+        let mut entry: crate::config::PluginEntryConfig =
+            toml::from_str(r#"role = "grasp-planner""#).unwrap();
+        let plain = PluginInfo::new("p", "0", &["grasp-planner"], "");
+        let concurrent = plain.clone().with_capabilities(&[PluginInfo::CONCURRENT]);
+        assert!(default_workers() >= 1);
+        assert_eq!(workers_for(&entry, &concurrent), default_workers().min(64));
+        assert_eq!(workers_for(&entry, &plain), 1);
+        entry.workers = Some(3);
+        assert_eq!(workers_for(&entry, &concurrent), 3);
+        assert_eq!(workers_for(&entry, &plain), 1);
+        entry.workers = Some(0);
+        assert_eq!(workers_for(&entry, &concurrent), 1);
+    }
 }

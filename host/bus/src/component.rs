@@ -203,9 +203,10 @@ impl Component {
     /// Hands every query on `key` to `callback`, which may keep the `Query` and
     /// reply later from another thread (zenoh sends the reply when it is dropped).
     ///
-    /// The queryable is declared complete: under zenoh's default query target
-    /// (best matching) a query on `key` goes to it alone, not also to the host's
-    /// fallback `<ns>/*/stop` (which answers `no_plugin` for absent roles).
+    /// The queryable is declared complete. Tsukami's callers send to every
+    /// matching queryable ([`crate::client::query`]): the host's fallback
+    /// `<ns>/*/stop` (`no_plugin` for absent roles) gets the query too and stands
+    /// aside, and a second process declaring `key` is `conflicting_responders`.
     pub fn serve_query<F>(&self, key: &str, callback: F) -> Result<Queryable<()>>
     where
         F: Fn(Query) + Send + Sync + 'static,

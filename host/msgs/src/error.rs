@@ -37,6 +37,9 @@ pub enum ErrorCode {
     TimeLimit,
     /// The plugin panicked; the host caught it and keeps serving.
     PluginPanicked,
+    /// Two or more processes answered one request: another process declares the
+    /// same key, so no reply can be trusted to be the real one's.
+    ConflictingResponders,
     /// Any other failure inside a plugin or component.
     Internal,
 }
@@ -59,6 +62,7 @@ impl ErrorCode {
             ErrorCode::Timeout => "timeout",
             ErrorCode::TimeLimit => "time_limit",
             ErrorCode::PluginPanicked => "plugin_panicked",
+            ErrorCode::ConflictingResponders => "conflicting_responders",
             ErrorCode::Internal => "internal",
         }
     }
@@ -188,6 +192,7 @@ mod tests {
             ErrorCode::PluginPanicked,
             ErrorCode::NotReady,
             ErrorCode::TimeLimit,
+            ErrorCode::ConflictingResponders,
         ] {
             assert_eq!(ErrorCode::from_wire(code.as_str()), code);
         }

@@ -33,7 +33,8 @@ pub struct PluginEntry {
     /// `concurrent` (it may run several calls at once).
     #[serde(default)]
     pub capabilities: Vec<String>,
-    /// Calls the host runs at once for it (1 unless `concurrent`).
+    /// Calls the host runs at once for it (1 unless `concurrent`; then its
+    /// config's `workers`, by default the host machine's cores).
     #[serde(default = "one")]
     pub workers: usize,
 }

@@ -81,7 +81,8 @@ pub type FfiPluginBox = FfiPlugin_TO<'static, RBox<()>>;
 pub trait FfiHost: Send + Sync + Clone {
     /// Publishes `payload` on `<ns>/<key>`.
     fn publish(&self, key: RStr<'_>, payload: RSlice<'_, u8>) -> RResult<(), RString>;
-    /// Queries `<ns>/<key>` and waits at most `timeout_ms` for the first reply.
+    /// Queries `<ns>/<key>` and waits at most `timeout_ms` for the reply (every
+    /// responder is heard: two answering is `conflicting_responders`).
     fn request(
         &self,
         key: RStr<'_>,

@@ -28,6 +28,7 @@ pub mod follow;
 pub mod latest;
 pub mod plugin;
 pub mod scene;
+mod unread;
 pub mod viewer;
 pub mod web;
 pub mod world;

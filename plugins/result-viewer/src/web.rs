@@ -13,9 +13,10 @@
 //!
 //! How: `std::net` with a thread per connection, at most `max_clients` at
 //! once (more get 503). The whole request head has a deadline (5 s from the
-//! connection; then 408), each event must be taken within 5 s, and an event
-//! stream's kernel send buffer is small, so a slow, stalled or vanished browser
-//! ends only its own thread, soon; nothing here ever holds a lock the bus
+//! connection; then 408), each event must be written within 5 s, a page that
+//! leaves more than its last event unread for 5 s is cut (its TCP window tells,
+//! [`crate::unread`]), and an event stream's kernel send buffer is small, so a
+//! slow, stalled or vanished browser ends only its own thread, soon; nothing here ever holds a lock the bus
 //! followers or the plugin's calls wait on while writing. A request whose
 //! `Host` is not a loopback name is refused when bound to loopback (DNS
 //! rebinding).
@@ -27,6 +28,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use crate::unread::{set_send_buffer, Unread};
 use crate::viewer::Viewer;
 
 /// Socket read and write timeout; also the whole request head's deadline and
@@ -42,6 +44,8 @@ const MAX_HEAD: usize = 8192;
 pub const MIN_EVENT_INTERVAL: Duration = Duration::from_millis(100);
 /// A comment is sent on a quiet event stream this often (finds closed pages).
 const KEEPALIVE: Duration = Duration::from_secs(10);
+/// The keep-alive comment.
+const KEEPALIVE_COMMENT: &[u8] = b": keep-alive\n\n";
 
 const INDEX: &[u8] = include_bytes!("../assets/index.html");
 const SCRIPT: &[u8] = include_bytes!("../assets/viewer.js");
@@ -291,13 +295,15 @@ fn serve(
 }
 
 /// The event stream: the state now, then on every change (rate-limited) and
-/// a keep-alive comment when quiet; ends on a failed write or on close.
+/// a keep-alive comment when quiet; ends on a failed write, on close, or when
+/// the page has left more than its last event unread for [`IO_TIMEOUT`].
 fn events(mut stream: TcpStream, viewer: &Viewer, stop: &AtomicBool) -> io::Result<()> {
     set_send_buffer(&stream, EVENT_SNDBUF);
     stream.write_all(
         b"HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-cache\r\nConnection: keep-alive\r\n\r\n",
     )?;
     viewer.event_clients.fetch_add(1, Ordering::Relaxed);
+    let mut unread = Unread::default();
     let result = (|| loop {
         let seen = viewer.board.generation();
         let state = viewer.state_json();
@@ -306,25 +312,44 @@ fn events(mut stream: TcpStream, viewer: &Viewer, stop: &AtomicBool) -> io::Resu
         event.extend_from_slice(&state);
         event.extend_from_slice(b"\n\n");
         write_by(&mut stream, &event, Instant::now() + IO_TIMEOUT)?;
+        unread.wrote(event.len());
         viewer.sent();
         let sent_at = Instant::now();
         loop {
             if stop.load(Ordering::Relaxed) || viewer.board.is_closed() {
                 return Ok(());
             }
-            if viewer.board.wait_past(seen, KEEPALIVE).is_some() {
+            taken_in_time(&mut unread, &stream)?;
+            // Watch a page that is behind closely; otherwise wait for a change.
+            let wait = if unread.behind() {
+                MIN_EVENT_INTERVAL
+            } else {
+                KEEPALIVE
+            };
+            if viewer.board.wait_past(seen, wait).is_some() {
                 break;
             }
-            write_by(
-                &mut stream,
-                b": keep-alive\n\n",
-                Instant::now() + IO_TIMEOUT,
-            )?;
+            if unread.quiet_for() >= KEEPALIVE {
+                write_by(&mut stream, KEEPALIVE_COMMENT, Instant::now() + IO_TIMEOUT)?;
+                unread.wrote(KEEPALIVE_COMMENT.len());
+            }
         }
         std::thread::sleep(MIN_EVENT_INTERVAL.saturating_sub(sent_at.elapsed()));
     })();
     viewer.event_clients.fetch_sub(1, Ordering::Relaxed);
     result
+}
+
+/// Fails once the page has left more than its last write unread for
+/// [`IO_TIMEOUT`] (see [`Unread`]).
+fn taken_in_time(unread: &mut Unread, stream: &TcpStream) -> io::Result<()> {
+    match unread.check(stream) {
+        Some(stalled) if stalled >= IO_TIMEOUT => Err(io::Error::new(
+            io::ErrorKind::TimedOut,
+            "event stream not read for 5 s",
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Writes all of `bytes` by `deadline` (the socket timeout alone restarts with
@@ -349,25 +374,3 @@ fn write_by(stream: &mut TcpStream, mut bytes: &[u8], deadline: Instant) -> io::
     }
     Ok(())
 }
-
-/// Sets the socket's send buffer (`SO_SNDBUF`); a failure leaves the default
-/// (the write deadline still holds).
-#[cfg(unix)]
-fn set_send_buffer(stream: &TcpStream, bytes: usize) {
-    use std::os::fd::AsRawFd;
-    let value = bytes as libc::c_int;
-    // SAFETY: setsockopt on a socket this thread owns, with a pointer to a live
-    // c_int and its size. A failure (returned, not signalled) keeps the default.
-    let _ = unsafe {
-        libc::setsockopt(
-            stream.as_raw_fd(),
-            libc::SOL_SOCKET,
-            libc::SO_SNDBUF,
-            (&value as *const libc::c_int).cast(),
-            std::mem::size_of::<libc::c_int>() as libc::socklen_t,
-        )
-    };
-}
-
-#[cfg(not(unix))]
-fn set_send_buffer(_: &TcpStream, _: usize) {}

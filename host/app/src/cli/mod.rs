@@ -282,7 +282,7 @@ fn print_reply(reply: Result<Vec<u8>, RequestError>) -> Result<ExitCode> {
             println!("{}", pretty(&bytes));
             Ok(ExitCode::SUCCESS)
         }
-        Err(RequestError::Reply(error)) => {
+        Err(RequestError::Reply(error) | RequestError::Conflict(error)) => {
             println!("{}", serde_json::to_string_pretty(&error)?);
             eprintln!("tsukami: {error}");
             Ok(ExitCode::FAILURE)
