@@ -325,14 +325,18 @@ fn squeeze_is_commanded(world: &World, t: &JointTrajectory, grasp: &PlanReply) {
     }
     let table = JointTable::from_model(&world.robot.model);
     let mut ex = Executor::new(table, 100.0, None).unwrap();
-    ex.start(t, 1e-9).expect("the controller accepts it from rest");
+    ex.start(t, 1e-9)
+        .expect("the controller accepts it from rest");
     while ex.step().is_none() {}
     let state = ex.state();
     assert_eq!(state.status, "done");
     let last = t.points.last().unwrap();
     for (i, name) in t.joint_names.iter().enumerate() {
         let j = state.joint_names.iter().position(|n| n == name).unwrap();
-        assert!((state.positions[j] - last.positions[i]).abs() < 1e-9, "{name}");
+        assert!(
+            (state.positions[j] - last.positions[i]).abs() < 1e-9,
+            "{name}"
+        );
         let want = target(name).map_or(last.positions[i], |s| s.target);
         assert!((state.commanded[j] - want).abs() < 1e-9, "{name} commanded");
     }

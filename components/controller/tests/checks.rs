@@ -239,33 +239,26 @@ fn squeeze_trajectory() -> JointTrajectory {
     t
 }
 
+/// Asserts that the refusal of `t` says every one of `parts`.
+fn refused_saying(t: &JointTrajectory, parts: &[&str]) {
+    let reason = refused(t);
+    assert!(parts.iter().all(|p| reason.contains(p)), "{reason}");
+}
+
 #[test]
 fn bad_commands_are_refused_naming_the_point_and_joint() {
     let mut t = squeeze_trajectory();
     t.points[2].command = vec![1.1];
-    let reason = refused(&t);
-    assert!(
-        reason.contains("point 2") && reason.contains("1 commands for 2 joints"),
-        "{reason}"
-    );
+    refused_saying(&t, &["point 2", "1 commands for 2 joints"]);
     let mut t = squeeze_trajectory();
     t.points[3].command[1] = f64::INFINITY;
-    let reason = refused(&t);
-    assert!(
-        reason.contains("point 3")
-            && reason.contains("r_index_j2")
-            && reason.contains("not a finite number"),
-        "{reason}"
-    );
+    refused_saying(&t, &["point 3", "r_index_j2", "not a finite number"]);
     // r_index_j2 is limited to [0, 1.6].
     let mut t = squeeze_trajectory();
     t.points[3].command[1] = 1.7;
-    let reason = refused(&t);
-    assert!(
-        reason.contains("point 3")
-            && reason.contains("`r_index_j2` command 1.7")
-            && reason.contains("outside its limits"),
-        "{reason}"
+    refused_saying(
+        &t,
+        &["point 3", "`r_index_j2` command 1.7", "outside its limits"],
     );
     // A cubic command path that overshoots the limit between valid points.
     let mut t = squeeze_trajectory();
@@ -274,11 +267,7 @@ fn bad_commands_are_refused_naming_the_point_and_joint() {
     }
     t.points[2].command = vec![0.0, 1.6];
     t.points[3].command = vec![-0.2, 1.6];
-    let reason = refused(&t);
-    assert!(
-        reason.contains("r_index_j2") && reason.contains("would be commanded"),
-        "{reason}"
-    );
+    refused_saying(&t, &["points 2-3", "r_index_j2", "would be commanded"]);
 }
 
 #[test]

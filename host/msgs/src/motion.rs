@@ -130,7 +130,8 @@ pub struct MotionGraspType {
 #[serde(deny_unknown_fields)]
 pub struct MotionPlanReply {
     /// The trajectory, as `<ns>/controller/execute` takes it; every point's
-    /// `phase` is `reach`, `approach`, `close` or `lift`.
+    /// `phase` is `reach`, `approach`, `close` or `lift`; when the grasp has a
+    /// `squeeze`, the last `close` point and every `lift` point carry `command`.
     pub trajectory: JointTrajectory,
     /// Where the start came from: `request`, `controller` or `rest` (joints the
     /// request named come from it in every case).

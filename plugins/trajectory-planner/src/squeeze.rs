@@ -223,7 +223,10 @@ mod tests {
         assert!(message.contains("no joint `nope`"), "{message}");
         let (field, message) = refused(&[entry("arm", 0.6)]);
         assert_eq!(field, "grasp.squeeze[0].joint");
-        assert!(message.contains("`arm` is not one of the hand's"), "{message}");
+        assert!(
+            message.contains("`arm` is not one of the hand's"),
+            "{message}"
+        );
         let (_, message) = refused(&[entry("f2", 0.6)]);
         assert!(message.contains("mimics `f1`"), "{message}");
         let (field, message) = refused(&[entry("f1", 0.6), entry("f1", 0.7)]);

@@ -65,7 +65,10 @@ fn check(scene: &str) {
 /// `lift` point: the squeezed joints at their targets, the others at the
 /// point's positions; no other point has a command.
 fn squeezed(scene: &str, t: &JointTrajectory, grasp: &MotionGrasp) {
-    assert!(!grasp.squeeze.is_empty(), "{scene}: the Plan reply squeezes");
+    assert!(
+        !grasp.squeeze.is_empty(),
+        "{scene}: the Plan reply squeezes"
+    );
     for s in &grasp.squeeze {
         assert!(t.joint_names.contains(&s.joint), "{scene}: {}", s.joint);
     }
