@@ -173,6 +173,15 @@ fn done_at_the_end(request: &ExecuteRequest) -> ExecuteReply {
     let state = ControllerState {
         joint_names: trajectory.joint_names.clone(),
         positions: last.map(|p| p.positions.clone()).unwrap_or_default(),
+        commanded: last
+            .map(|p| {
+                if p.command.is_empty() {
+                    p.positions.clone()
+                } else {
+                    p.command.clone()
+                }
+            })
+            .unwrap_or_default(),
         status: "done".into(),
         time,
         velocities: vec![0.0; trajectory.joint_names.len()],

@@ -322,6 +322,7 @@ fn two_points(
         positions,
         velocities: vec![],
         phase: String::new(),
+        command: vec![],
     };
     JointTrajectory {
         joint_names: names,
@@ -495,6 +496,7 @@ fn headless_plan_with_mock_components() {
     let rest = ControllerState {
         joint_names: goal.keys().cloned().collect(),
         positions: vec![0.0; goal.len()],
+        commanded: vec![],
         status: "idle".into(),
         time: 0.0,
         velocities: vec![],

@@ -14,7 +14,9 @@
 //!   may touch the object up to 1 mm while approaching and closing, as the grasp
 //!   planner's verification allows), no self-collision of the arm and hand;
 //! - the lift raises the object (carried at the palm) without it or any non-hand
-//!   link entering anything.
+//!   link entering anything;
+//! - the Plan reply's squeeze is commanded from the end of `close` through the
+//!   lift, and the controller running the trajectory ends commanding its targets.
 
 use std::time::Duration;
 
@@ -27,6 +29,7 @@ use tsukami_body::model::LinkId;
 use tsukami_bus::client::{BusClient, RequestError};
 use tsukami_controller::joints::JointTable;
 use tsukami_controller::trajectory::Plan;
+use tsukami_controller::Executor;
 use tsukami_e2e::{models_dir, motion_entry, planner_entry, test_config, TestBus};
 use tsukami_msgs::common::Pose;
 use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER, ROLE_TRAJECTORY_PLANNER};
@@ -306,6 +309,39 @@ fn ends_at_the_grasp(world: &World, t: &JointTrajectory, grasp: &PlanReply) {
     }
 }
 
+/// The controller runs the trajectory from rest and ends commanding the Plan
+/// reply's squeeze targets to the squeezed joints (the lift held them), the
+/// trajectory's last positions everywhere (the physical posture); from the end of
+/// `close` on, the points command the targets.
+fn squeeze_is_commanded(world: &World, t: &JointTrajectory, grasp: &PlanReply) {
+    assert!(!grasp.squeeze.is_empty(), "the Plan reply squeezes");
+    let target = |name: &str| grasp.squeeze.iter().find(|s| s.joint == name);
+    let from = t.points.iter().rposition(|p| p.phase == "close").unwrap();
+    for (k, p) in t.points.iter().enumerate().skip(from) {
+        for (i, name) in t.joint_names.iter().enumerate() {
+            let want = target(name).map_or(p.positions[i], |s| s.target);
+            assert_eq!(p.command.get(i), Some(&want), "point {k}: {name}");
+        }
+    }
+    let table = JointTable::from_model(&world.robot.model);
+    let mut ex = Executor::new(table, 100.0, None).unwrap();
+    ex.start(t, 1e-9)
+        .expect("the controller accepts it from rest");
+    while ex.step().is_none() {}
+    let state = ex.state();
+    assert_eq!(state.status, "done");
+    let last = t.points.last().unwrap();
+    for (i, name) in t.joint_names.iter().enumerate() {
+        let j = state.joint_names.iter().position(|n| n == name).unwrap();
+        assert!(
+            (state.positions[j] - last.positions[i]).abs() < 1e-9,
+            "{name}"
+        );
+        let want = target(name).map_or(last.positions[i], |s| s.target);
+        assert!((state.commanded[j] - want).abs() < 1e-9, "{name} commanded");
+    }
+}
+
 fn plan_and_recheck(name: &str) {
     let bus = bus();
     let (grasp, world) = grasp_of(&bus, name);
@@ -320,6 +356,7 @@ fn plan_and_recheck(name: &str) {
     assert_eq!(seen, order, "{name}: phases in order");
     check_timing_and_limits(&world, t);
     ends_at_the_grasp(&world, t, &grasp);
+    squeeze_is_commanded(&world, t, &grasp);
     let checks = check_collisions(&world, t);
     eprintln!(
         "{name}: {} points, {:.2} s, {} samples, {} planner checks, {checks} re-checks, {:.1} ms",
@@ -629,6 +666,17 @@ fn bad_grasps_name_the_field_and_the_plugin_keeps_serving() {
         field(motion(&bus.client, &json!({ "grasp": g }))),
         (ErrorCode::InvalidValue, "grasp.palm_pose".into())
     );
+    for (key, value, at) in [
+        ("joint", json!("no_such_joint"), "grasp.squeeze[0].joint"),
+        ("target", json!(99.0), "grasp.squeeze[0].target"),
+    ] {
+        let mut g = serde_json::to_value(&grasp).unwrap();
+        g["squeeze"][0][key] = value;
+        assert_eq!(
+            field(motion(&bus.client, &json!({ "grasp": g }))),
+            (ErrorCode::InvalidValue, at.into())
+        );
+    }
     let mut g = serde_json::to_value(&grasp).unwrap();
     g.as_object_mut().unwrap().remove("joint_positions");
     assert_eq!(

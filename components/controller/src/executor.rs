@@ -14,6 +14,11 @@
 //! is. Between runs
 //! the state is held, so the next trajectory continues from where the last ended.
 //!
+//! Each period also samples what the trajectory commands ([`Plan::sample_command`]:
+//! its points' `command`, else their positions) into the state's `commanded`;
+//! after a run it holds, so a squeeze applied at the end of `close` stays
+//! commanded until the next trajectory (whose points command their own).
+//!
 //! ```
 //! use tsukami_controller::{executor::Executor, joints::JointTable};
 //! use tsukami_msgs::motion::{JointTrajectory, TrajectoryPoint};
@@ -22,7 +27,7 @@
 //!   <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"#;
 //! let table = JointTable::from_model(&tsukami_body::RobotModel::from_urdf_str(urdf, ".".as_ref()).unwrap());
 //! let mut ex = Executor::new(table, 100.0, None).unwrap();
-//! let point = |time: f64, q: f64| TrajectoryPoint { time, positions: vec![q], velocities: vec![], phase: String::new() };
+//! let point = |time: f64, q: f64| TrajectoryPoint { time, positions: vec![q], velocities: vec![], phase: String::new(), command: vec![] };
 //! ex.start(&JointTrajectory { joint_names: vec!["j".into()], points: vec![point(0.0, 0.0), point(0.5, 0.25)] }, 0.01).unwrap();
 //! let mut steps = 0;
 //! while ex.step().is_none() { steps += 1; }
@@ -43,6 +48,9 @@ pub struct Executor {
     tick: u64,
     positions: Vec<f64>,
     velocities: Vec<f64>,
+    /// What is commanded, table order: the positions, or a running (or the
+    /// last) trajectory's `command` where it squeezes.
+    commanded: Vec<f64>,
     status: &'static str,
     run: Option<Run>,
     /// Time from the running trajectory's start of the last sample; kept for the
@@ -57,6 +65,7 @@ struct Run {
     /// Scratch for one sample, in plan order.
     q: Vec<f64>,
     v: Vec<f64>,
+    c: Vec<f64>,
 }
 
 impl Executor {
@@ -80,6 +89,7 @@ impl Executor {
             dt: 1.0 / rate_hz,
             tick: 0,
             velocities: vec![0.0; positions.len()],
+            commanded: positions.clone(),
             positions,
             status: "idle",
             run: None,
@@ -106,6 +116,11 @@ impl Executor {
     /// Current positions, table order.
     pub fn positions(&self) -> &[f64] {
         &self.positions
+    }
+
+    /// What is commanded now, table order (see [`ControllerState::commanded`]).
+    pub fn commanded(&self) -> &[f64] {
+        &self.commanded
     }
 
     /// Whether a trajectory is running.
@@ -143,6 +158,7 @@ impl Executor {
             start_tick: self.tick,
             q: vec![0.0; n],
             v: vec![0.0; n],
+            c: vec![0.0; n],
         });
         self.status = "executing";
         self.trajectory_time = Some(0.0);
@@ -158,10 +174,12 @@ impl Executor {
         let t = ((self.tick - run.start_tick) as f64 * self.dt).min(run.plan.duration());
         let done = t >= run.plan.duration();
         run.plan.sample(t, &mut run.q, &mut run.v);
+        run.plan.sample_command(t, &mut run.c);
         self.trajectory_time = Some(t);
         for (j, &i) in run.plan.joints().iter().enumerate() {
             self.positions[i] = run.q[j];
             self.velocities[i] = if done { 0.0 } else { run.v[j] };
+            self.commanded[i] = run.c[j];
         }
         if done {
             return Some(self.finish(ExecutionOutcome::Done));
@@ -199,6 +217,7 @@ impl Executor {
         ControllerState {
             joint_names: self.table.names(),
             positions: self.positions.clone(),
+            commanded: self.commanded.clone(),
             status: self.status.to_owned(),
             time: self.tick as f64 * self.dt,
             velocities: self.velocities.clone(),

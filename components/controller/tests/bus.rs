@@ -57,6 +57,7 @@ fn line(joint: &str, from: f64, to: f64, time: f64) -> JointTrajectory {
         positions: vec![q],
         velocities: vec![],
         phase: String::new(),
+        command: vec![],
     };
     JointTrajectory {
         joint_names: vec![joint.into()],

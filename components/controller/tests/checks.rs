@@ -18,6 +18,7 @@ fn point(time: f64, positions: &[f64]) -> TrajectoryPoint {
         positions: positions.to_vec(),
         velocities: vec![],
         phase: String::new(),
+        command: vec![],
     }
 }
 
@@ -219,4 +220,109 @@ fn cancel_ends_the_run_in_one_period_where_it_is() {
 
 fn index(ex: &Executor, joint: &str) -> usize {
     ex.table().names().iter().position(|n| n == joint).unwrap()
+}
+
+/// `r_index_j2` closes from 0 to 0.8 (contact) over [0, 1] s and is commanded
+/// to 1.1 (the squeeze) from then on; the lift point holds it.
+fn squeeze_trajectory() -> JointTrajectory {
+    let mut t = trajectory(
+        &["r_elbow", "r_index_j2"],
+        vec![
+            point(0.0, &[0.0, 0.0]),
+            point(0.5, &[0.0, 0.4]),
+            point(1.0, &[0.0, 0.8]),
+            point(1.5, &[-0.2, 0.8]),
+        ],
+    );
+    t.points[2].command = vec![0.0, 1.1];
+    t.points[3].command = vec![-0.2, 1.1];
+    t
+}
+
+/// Asserts that the refusal of `t` says every one of `parts`.
+fn refused_saying(t: &JointTrajectory, parts: &[&str]) {
+    let reason = refused(t);
+    assert!(parts.iter().all(|p| reason.contains(p)), "{reason}");
+}
+
+#[test]
+fn bad_commands_are_refused_naming_the_point_and_joint() {
+    let mut t = squeeze_trajectory();
+    t.points[2].command = vec![1.1];
+    refused_saying(&t, &["point 2", "1 commands for 2 joints"]);
+    let mut t = squeeze_trajectory();
+    t.points[3].command[1] = f64::INFINITY;
+    refused_saying(&t, &["point 3", "r_index_j2", "not a finite number"]);
+    // r_index_j2 is limited to [0, 1.6].
+    let mut t = squeeze_trajectory();
+    t.points[3].command[1] = 1.7;
+    refused_saying(
+        &t,
+        &["point 3", "`r_index_j2` command 1.7", "outside its limits"],
+    );
+    // A cubic command path that overshoots the limit between valid points.
+    let mut t = squeeze_trajectory();
+    for (p, v) in t.points.iter_mut().zip([0.0, 0.0, 3.0, 0.0]) {
+        p.velocities = vec![0.0, v];
+    }
+    t.points[2].command = vec![0.0, 1.6];
+    t.points[3].command = vec![-0.2, 1.6];
+    refused_saying(&t, &["points 2-3", "r_index_j2", "would be commanded"]);
+}
+
+#[test]
+fn commands_are_interpolated_reported_and_held() {
+    let mut ex = executor();
+    let t = squeeze_trajectory();
+    ex.start(&t, 0.01).unwrap();
+    let (ie, ii) = (index(&ex, "r_elbow"), index(&ex, "r_index_j2"));
+    // Commanded: the positions up to 0.5 s, then ramped from 0.4 to 1.1 by 1 s.
+    let commanded = [(0.0, 0.0), (0.5, 0.4), (1.0, 1.1), (1.5, 1.1)];
+    let finger = [(0.0, 0.0), (0.5, 0.4), (1.0, 0.8), (1.5, 0.8)];
+    let elbow = [(0.0, 0.0), (1.0, 0.0), (1.5, -0.2)];
+    loop {
+        let ended = ex.step();
+        let state = ex.state();
+        let s = state.trajectory_time.unwrap();
+        assert!((state.positions[ii] - expected_linear(&finger, s)).abs() < 1e-9);
+        assert!((state.commanded[ii] - expected_linear(&commanded, s)).abs() < 1e-9);
+        assert!((state.commanded[ie] - expected_linear(&elbow, s)).abs() < 1e-9);
+        assert_eq!(state.commanded[ie], state.positions[ie], "t = {s}");
+        if ended.is_some() {
+            break;
+        }
+    }
+    for _ in 0..5 {
+        ex.step(); // idle: the squeeze stays commanded
+    }
+    let state = ex.state();
+    assert_eq!(state.status, "done");
+    assert_eq!((state.positions[ii], state.commanded[ii]), (0.8, 1.1));
+    // Every other joint is commanded where it is.
+    for (i, (q, c)) in state.positions.iter().zip(&state.commanded).enumerate() {
+        if i != ii {
+            assert_eq!(q, c, "joint {i}");
+        }
+    }
+    // The next trajectory starts from the positions, and commands its own.
+    let release = trajectory(
+        &["r_index_j2"],
+        vec![point(0.0, &[0.8]), point(0.5, &[0.0])],
+    );
+    ex.start(&release, 0.01).unwrap();
+    while ex.step().is_none() {}
+    assert_eq!(ex.commanded()[ii], 0.0);
+}
+
+#[test]
+fn without_commands_the_positions_are_commanded() {
+    let mut ex = executor();
+    assert_eq!(ex.state().commanded, ex.state().positions);
+    let mut t = squeeze_trajectory();
+    t.points.iter_mut().for_each(|p| p.command.clear());
+    ex.start(&t, 0.01).unwrap();
+    while ex.step().is_none() {
+        assert_eq!(ex.state().commanded, ex.state().positions);
+    }
+    assert_eq!(ex.state().commanded, ex.state().positions);
 }

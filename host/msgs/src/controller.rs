@@ -70,6 +70,13 @@ pub struct ControllerState {
     pub joint_names: Vec<String>,
     /// Current joint positions.
     pub positions: Vec<f64>,
+    /// What the controller commands now, `joint_names` order: the running
+    /// trajectory's interpolated `command` (its `positions` where a point has
+    /// none), held after the run ends until the next one. It differs from
+    /// `positions` only where a trajectory squeezes (a finger stopped by the
+    /// object, commanded beyond it). Empty from controllers that predate it.
+    #[serde(default)]
+    pub commanded: Vec<f64>,
     /// `idle`, `executing`, or how the last run ended: `done`, `cancelled`, `error`.
     pub status: String,
     /// Controller time, seconds (`tick` control periods since the controller started).

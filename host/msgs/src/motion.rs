@@ -1,7 +1,7 @@
 //! Trajectory-planner messages (`<ns>/motion/plan`).
 
 use crate::common::{JointMap, Pose};
-use crate::planner::ContactReply;
+use crate::planner::{ContactReply, JointSqueeze};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -102,6 +102,20 @@ pub struct MotionGrasp {
     /// default: the object's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub characteristic_length: Option<f64>,
+    /// The squeeze beyond contact (the Plan reply's `squeeze`): per independent
+    /// hand joint, the torque a torque-controlled hand applies and the target a
+    /// position-controlled hand commands. When given, the trajectory's last
+    /// `close` point and every `lift` point carry
+    /// [`command`](TrajectoryPoint::command) with each squeezed joint at its
+    /// `target` (a mimic joint of the trajectory at its leader's target through
+    /// the URDF's multiplier and offset), so the squeeze is applied from the end
+    /// of `close` and held through the lift; a torque-controlled hand applies
+    /// each `torque` over the same points. Every entry's joint must be one of
+    /// the hand's independent joints, named once, its numbers finite and its
+    /// `target` within the joint's limits. Empty: no squeeze, the fingers are
+    /// commanded to the grasp posture.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub squeeze: Vec<JointSqueeze>,
 }
 
 /// The grasp type of a [`MotionGrasp`].
@@ -116,7 +130,8 @@ pub struct MotionGraspType {
 #[serde(deny_unknown_fields)]
 pub struct MotionPlanReply {
     /// The trajectory, as `<ns>/controller/execute` takes it; every point's
-    /// `phase` is `reach`, `approach`, `close` or `lift`.
+    /// `phase` is `reach`, `approach`, `close` or `lift`; when the grasp has a
+    /// `squeeze`, the last `close` point and every `lift` point carry `command`.
     pub trajectory: JointTrajectory,
     /// Where the start came from: `request`, `controller` or `rest` (joints the
     /// request named come from it in every case).
@@ -183,7 +198,8 @@ pub struct TrajectoryPoint {
     /// Time from the trajectory's start, seconds (also accepted as `time_from_start`).
     #[serde(alias = "time_from_start")]
     pub time: f64,
-    /// Joint positions in `joint_names` order.
+    /// Joint positions in `joint_names` order: the physical posture at this
+    /// point (what every collision and limit check is about).
     pub positions: Vec<f64>,
     /// Joint velocities in `joint_names` order; empty for none (then the controller
     /// interpolates linearly between positions).
@@ -193,4 +209,16 @@ pub struct TrajectoryPoint {
     /// `approach`, `close`, `lift` (empty when the maker has no phases).
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub phase: String,
+    /// The positions a position controller commands at this point, in
+    /// `joint_names` order, where they differ from `positions`; empty: command
+    /// `positions`. A squeezed finger is stopped by the object at `positions`
+    /// while its command lies beyond, inside the object: the servo error between
+    /// the two is what presses (the trajectory planner sets it from the grasp's
+    /// `squeeze`, on the last `close` point and every `lift` point). The
+    /// controller interpolates commands between points as it does positions (a
+    /// point without one commands its positions), so a command that first
+    /// appears at the end of `close` is ramped in over that point's segment.
+    /// Every value is finite and within its joint's limits.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub command: Vec<f64>,
 }

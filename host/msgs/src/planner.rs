@@ -721,13 +721,15 @@ pub struct JointSqueeze {
     pub joint: String,
     /// Position at contact (rad or m): the grasp posture.
     pub position: f64,
-    /// Torque (N·m, or N for a prismatic joint) a torque-controlled hand applies.
+    /// Torque (N·m, or N for a prismatic joint) a torque-controlled hand applies,
+    /// from the end of the motion's `close` phase through its lift.
     pub torque: f64,
     /// Servo stiffness (N·m/rad) the target assumes: the joint's effort over
     /// the hand's `servo_saturation`.
     pub stiffness: f64,
     /// Target of a position-controlled hand: `position` + the motion that closes the contacts' gaps + `torque / stiffness`,
-    /// clamped to the joint's limits (what a hand controller commands after `close`).
+    /// clamped to the joint's limits (what a position-controlled hand commands from
+    /// the end of `close` through the lift: the motion's points' `command`).
     pub target: f64,
 }
 

@@ -51,6 +51,7 @@ pub fn assemble(joint_names: Vec<String>, phases: &[Phase], limits: &Limits) -> 
                 positions: p.positions.clone(),
                 velocities: p.velocities.clone(),
                 phase: phase.name.to_owned(),
+                command: Vec::new(),
             });
         }
         t0 = points.last().map_or(0.0, |p| p.time);

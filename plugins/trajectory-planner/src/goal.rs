@@ -22,7 +22,8 @@
 //! where the grasp planner started closing them, or part way there
 //! ([`Goal::open_by`]); the remaining hand joints are at their grasp values. The approach direction is the
 //! grasp type's `approach` (palm frame) turned by the palm pose, unless the
-//! request gives one.
+//! request gives one. The grasp's `squeeze` is checked against the hand
+//! ([`crate::squeeze::targets`]).
 
 use nalgebra::{Isometry3, Vector3};
 use tsukami_body::kinematics::FkState;
@@ -60,6 +61,9 @@ pub struct Goal {
     pub palm: Isometry3<f64>,
     /// Unit direction the palm moves in along the approach (world frame).
     pub approach: Vector3<f64>,
+    /// The grasp's squeeze: each squeezed hand joint and its target
+    /// ([`crate::squeeze::targets`]); empty when the grasp has none.
+    pub squeeze: Vec<(JointId, f64)>,
 }
 
 fn joint_value(
@@ -257,6 +261,7 @@ pub fn resolve(
         hand: hand.joints.clone(),
         open: closed.clone(),
         flex: opening_joints(robot, grasp),
+        squeeze: crate::squeeze::targets(model, &hand.joints, &grasp.squeeze)?,
         closed,
         palm,
     };

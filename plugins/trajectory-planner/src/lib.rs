@@ -18,7 +18,8 @@
 //!   trajectory;
 //! - [`goal`]: the request's start and grasp checked against the robot;
 //!   [`revalidate`]: the grasp's world version, and the grasp checked again on
-//!   the current world when asked;
+//!   the current world when asked; [`squeeze`]: the grasp's squeeze as the
+//!   `command` of the points from the end of `close` through the lift;
 //! - [`motion`]: the whole pipeline (keeping [`motion::Clearance`] from the
 //!   obstacles); [`clearance`]: the smallest distance a motion kept, for the reply; [`world`]: the planner kit's world, shared
 //!   with the grasp planners; [`error`]: failures and their codes.
@@ -36,5 +37,6 @@ pub mod resolution;
 pub mod revalidate;
 pub mod rrt_connect;
 pub mod shortcut;
+pub mod squeeze;
 pub mod timing;
 pub mod world;

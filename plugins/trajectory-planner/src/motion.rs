@@ -12,6 +12,11 @@
 //!   there: fully straight if nothing is in the way) to the grasp's angles;
 //! - **lift**: the palm moves `lift_height` straight up with the object attached.
 //!
+//! A grasp with a `squeeze` gives the last `close` point and every `lift` point
+//! a `command` ([`crate::squeeze`]): the squeezed fingers commanded to their
+//! targets beyond contact, held through the lift. Every check below runs on the
+//! points' positions, the physical posture; the command is not a posture.
+//!
 //! Why: every phase is checked at the same resolution ([`crate::resolution`]: no
 //! point of any link, or of the carried object, moves more than `max_travel`
 //! between two checks), against the obstacles, the object, the robot itself and
@@ -536,6 +541,8 @@ fn lift_path(s: &mut Scene<'_>, height: f64) -> Result<Vec<Vec<f64>>, MotionErro
     Ok(path)
 }
 
+/// The phases timed and joined, with the grasp's squeeze as the command from
+/// the end of `close` on.
 fn timed(s: &Scene<'_>, query: &MotionQuery<'_>, paths: [Vec<Vec<f64>>; 4]) -> JointTrajectory {
     let velocity = s
         .joints
@@ -578,5 +585,7 @@ fn timed(s: &Scene<'_>, query: &MotionQuery<'_>, paths: [Vec<Vec<f64>>; 4]) -> J
             path: lift,
         },
     ];
-    assemble(names, &phases, &limits)
+    let mut trajectory = assemble(names, &phases, &limits);
+    crate::squeeze::apply(s.model, &s.joints, &s.goal.squeeze, &mut trajectory);
+    trajectory
 }

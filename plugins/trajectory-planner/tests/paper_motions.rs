@@ -5,7 +5,7 @@
 
 mod common;
 
-use tsukami_msgs::motion::MotionGrasp;
+use tsukami_msgs::motion::{JointTrajectory, MotionGrasp};
 use tsukami_planner_kit::validate::Limits;
 use tsukami_trajectory_planner::motion::{plan_motion, Motion, MotionConfig, MotionQuery, Variant};
 
@@ -50,6 +50,7 @@ fn check(scene: &str) {
             assert!((q - g).abs() < 1e-9, "{scene}: {n}");
         }
     }
+    squeezed(scene, t, &grasp);
     assert_eq!(motion(scene, 1).0, m, "{scene}: deterministic");
     eprintln!(
         "{scene}: {} points, {:.2} s, {} samples, {} checks",
@@ -58,6 +59,40 @@ fn check(scene: &str) {
         m.samples,
         m.checks
     );
+}
+
+/// The grasp's squeeze is the command of the last `close` point and of every
+/// `lift` point: the squeezed joints at their targets, the others at the
+/// point's positions; no other point has a command.
+fn squeezed(scene: &str, t: &JointTrajectory, grasp: &MotionGrasp) {
+    assert!(
+        !grasp.squeeze.is_empty(),
+        "{scene}: the Plan reply squeezes"
+    );
+    for s in &grasp.squeeze {
+        assert!(t.joint_names.contains(&s.joint), "{scene}: {}", s.joint);
+    }
+    let last_close = t.points.iter().rposition(|p| p.phase == "close").unwrap();
+    for (k, p) in t.points.iter().enumerate() {
+        if k != last_close && p.phase != "lift" {
+            assert!(p.command.is_empty(), "{scene}: point {k} ({})", p.phase);
+            continue;
+        }
+        assert_eq!(p.command.len(), p.positions.len(), "{scene}: point {k}");
+        for (i, name) in t.joint_names.iter().enumerate() {
+            let want = grasp
+                .squeeze
+                .iter()
+                .find(|s| &s.joint == name)
+                .map_or(p.positions[i], |s| s.target);
+            assert_eq!(p.command[i], want, "{scene}: point {k}, {name}");
+        }
+    }
+    let moved = grasp
+        .squeeze
+        .iter()
+        .any(|s| (s.target - s.position).abs() > 1e-6);
+    assert!(moved, "{scene}: some target lies beyond contact");
 }
 
 #[test]

@@ -21,7 +21,7 @@
 //! use tsukami::demo::motion::split_at_grasp;
 //! use tsukami_msgs::motion::{JointTrajectory, TrajectoryPoint};
 //! let point = |time: f64, q: f64, phase: &str| TrajectoryPoint {
-//!     time, positions: vec![q], velocities: vec![], phase: phase.into(),
+//!     time, positions: vec![q], velocities: vec![], phase: phase.into(), command: vec![],
 //! };
 //! let t = JointTrajectory {
 //!     joint_names: vec!["j".into()],
@@ -363,6 +363,7 @@ mod tests {
             positions: vec![q],
             velocities: vec![0.0],
             phase: phase.into(),
+            command: vec![],
         }
     }
 
