@@ -61,6 +61,10 @@ pub struct Goal {
     pub palm: Isometry3<f64>,
     /// Unit direction the palm moves in along the approach (world frame).
     pub approach: Vector3<f64>,
+    /// The grasp type's closing joints (its contacts' `joint`s, in the
+    /// type's order: the order the grasp planner closed them); empty for a
+    /// type the robot does not know.
+    pub closing: Vec<JointId>,
     /// The grasp's squeeze: each squeezed hand joint and its target
     /// ([`crate::squeeze::targets`]); empty when the grasp has none.
     pub squeeze: Vec<(JointId, f64)>,
@@ -261,6 +265,7 @@ pub fn resolve(
         hand: hand.joints.clone(),
         open: closed.clone(),
         flex: opening_joints(robot, grasp),
+        closing: closing_joints(robot, grasp),
         squeeze: crate::squeeze::targets(model, &hand.joints, &grasp.squeeze)?,
         closed,
         palm,
@@ -270,6 +275,28 @@ pub fn resolve(
 }
 
 impl Goal {
+    /// The closing in the grasp planner's order, from the current opening:
+    /// first every opened joint but the type's closing joints back at the
+    /// grasp's angles (the pre-shape), then each closing joint in turn; the
+    /// postures after each step (the last is `closed`).
+    pub fn sequential_close(&self, model: &RobotModel) -> Vec<Vec<f64>> {
+        let mut q = self.open.clone();
+        for &(j, _) in &self.flex {
+            if !self.closing.contains(&j) {
+                q[j] = self.closed[j];
+            }
+        }
+        model.apply_mimics(&mut q);
+        let mut out = vec![q.clone()];
+        for &j in &self.closing {
+            q[j] = self.closed[j];
+            model.apply_mimics(&mut q);
+            out.push(q.clone());
+        }
+        out.push(self.closed.clone());
+        out
+    }
+
     /// Opens the hand by `opening` (1: every flex joint at 0, clamped into its
     /// limits; 0: the grasp's angles; linear between).
     pub fn open_by(&mut self, model: &RobotModel, opening: f64) {
@@ -279,6 +306,22 @@ impl Goal {
         }
         model.apply_mimics(&mut self.open);
     }
+}
+
+/// [`Goal::closing`]: the grasp type's contacts' closing joints, in order.
+fn closing_joints(robot: &Robot, grasp: &MotionGrasp) -> Vec<JointId> {
+    let hand = robot.hand();
+    hand.grasp_types
+        .grasp_types
+        .iter()
+        .find(|g| g.name == grasp.grasp_type.name)
+        .map(|g| {
+            g.contacts
+                .iter()
+                .filter_map(|c| robot.model.joint_id(&c.joint).ok())
+                .collect()
+        })
+        .unwrap_or_default()
 }
 
 /// [`Goal::flex`]: the flex joints straight, then the grasp type's other

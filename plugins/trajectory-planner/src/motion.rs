@@ -338,7 +338,6 @@ pub fn plan_motion(
         .map_err(|c| infeasible("goal_in_collision", "the grasp posture collides", &c))?;
     progress("approach", 0);
     let approach = open_and_approach(&mut s, query.pregrasp_distance)?;
-    let (open, closed) = (s.p(&s.goal.open), s.p(&s.goal.closed));
     let mut start_open = query.start.clone();
     for &j in &s.goal.hand {
         start_open[j] = s.goal.open[j];
@@ -359,9 +358,7 @@ pub fn plan_motion(
     let mut reach_phase = vec![opening[0].clone()];
     reach_phase.extend(reach.iter().map(|q| s.p(q)));
     progress("close", samples);
-    let w = s.touching(&s.goal.open, 0.0);
-    s.check(w, &[open.clone(), closed.clone()])
-        .map_err(|c| infeasible("close_blocked", "closing the hand collides", &c))?;
+    let close = close_clear(&mut s)?;
     progress("lift", samples);
     let lift = lift_path(&mut s, query.lift_height)?;
     progress("timing", samples);
@@ -371,7 +368,7 @@ pub fn plan_motion(
         [
             reach_phase,
             approach.iter().map(|q| s.p(q)).collect(),
-            vec![open, closed],
+            close,
             lift,
         ],
     );
@@ -387,8 +384,33 @@ pub fn plan_motion(
 /// obstacles and the object let it (1: fingers straight).
 pub const OPENINGS: [f64; 4] = [1.0, 0.75, 0.5, 0.25];
 
-/// Opens the hand as wide as [`OPENINGS`] allows at the grasp and along the
-/// approach; the approach path. The widest opening's failure when none works.
+/// The close from the current opening to the grasp's angles, its postures
+/// (the opening first), with no link of the hand sinking into the object or
+/// hitting anything: all joints together, or else in the grasp planner's
+/// order ([`Goal::sequential_close`]); the first failure when neither works.
+fn close_clear(s: &mut Scene<'_>) -> Result<Vec<Vec<f64>>, MotionError> {
+    let open = s.p(&s.goal.open);
+    let linear = vec![open.clone(), s.p(&s.goal.closed)];
+    let mut sequential = vec![open];
+    sequential.extend(s.goal.sequential_close(s.model).iter().map(|q| s.p(q)));
+    let mut first = None;
+    for path in [linear, sequential] {
+        let w = s.touching(&s.goal.open, 0.0);
+        match s.check(w, &path) {
+            Ok(()) => return Ok(path),
+            Err(c) => {
+                first.get_or_insert(c);
+            }
+        }
+    }
+    let c = first.expect("two paths were tried");
+    Err(infeasible("close_blocked", "closing the hand collides", &c))
+}
+
+/// Opens the hand as wide as [`OPENINGS`] allows at the grasp, along the
+/// approach and while the fingers close from it (a finger opened wide may
+/// sweep through the object on its way back); the approach path. The widest
+/// opening's failure when none works.
 fn open_and_approach(s: &mut Scene<'_>, distance: f64) -> Result<Vec<Vec<f64>>, MotionError> {
     let mut first = None;
     for opening in OPENINGS {
@@ -403,7 +425,8 @@ fn open_and_approach(s: &mut Scene<'_>, distance: f64) -> Result<Vec<Vec<f64>>, 
                     &c,
                 )
             })
-            .and_then(|()| approach_path(s, distance));
+            .and_then(|()| approach_path(s, distance))
+            .and_then(|path| close_clear(s).map(|_| path));
         match tried {
             Ok(path) => return Ok(path),
             Err(e) => {
