@@ -6,7 +6,9 @@
 //! other and nothing leaves the machine.
 //!
 //! [`mocks`]: a mock vision and a mock controller for headless tests.
+//! [`hostile`]: the garbage payloads and reply checks of the hostile corpora.
 
+pub mod hostile;
 pub mod mocks;
 
 use std::path::{Path, PathBuf};

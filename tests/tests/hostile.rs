@@ -23,6 +23,7 @@ use tsukami::bus::BusConfig;
 use tsukami::client::{BusClient, RequestError};
 use tsukami::config::HostConfig;
 use tsukami_bus::Component;
+use tsukami_e2e::hostile::{check_well_formed, garbage};
 use tsukami_e2e::{
     models_dir, planner_entry, plugin_entry, test_config, tsukami_exe, ChildGuard, TestBus,
 };
@@ -197,27 +198,6 @@ fn without_timing(mut v: serde_json::Value) -> serde_json::Value {
     v
 }
 
-/// A successful reply must be a JSON object; an error reply must not be
-/// `internal` or `plugin_panicked` (the client turns an error payload that is not
-/// the common error object into `internal`).
-fn check_well_formed(case: &str, reply: &Result<String, String>) {
-    match reply {
-        Ok(text) => {
-            let v: serde_json::Value = serde_json::from_str(text)
-                .unwrap_or_else(|e| panic!("{case}: reply is not JSON ({e}): {text:.300}"));
-            assert!(v.is_object(), "{case}: reply is not an object: {text:.300}");
-        }
-        Err(text) => {
-            let v: serde_json::Value = serde_json::from_str(text).unwrap();
-            let code = v["error"]["code"].as_str().unwrap_or_default();
-            assert!(
-                !code.is_empty() && code != "internal" && code != "plugin_panicked",
-                "{case}: error reply {text:.300}"
-            );
-        }
-    }
-}
-
 /// The mesh size limit of the test host, and the most triangles a binary STL
 /// within it holds (80-byte header, 4-byte count, 50 bytes a triangle).
 const MESH_LIMIT: u64 = 4 << 20;
@@ -377,26 +357,6 @@ fn case(name: String, command: &'static str, payload: Vec<u8>) -> Case {
         command,
         payload,
     }
-}
-
-/// Garbage payloads, sent to every command.
-fn garbage() -> Vec<Vec<u8>> {
-    vec![
-        b"[]".to_vec(),
-        b"1".to_vec(),
-        b"\"x\"".to_vec(),
-        b"null".to_vec(),
-        b"{".to_vec(),
-        b"\xff\xfe".to_vec(),
-        b"{\"a\":NaN}".to_vec(),
-        b"{\"mass\":1e400}".to_vec(),
-        "[".repeat(100_000).into_bytes(),
-        vec![b'{'; 50_000],
-        vec![b' '; 1 << 21],
-        format!("{{\"x\":\"{}\"}}", "a".repeat(2 << 20)).into_bytes(),
-        br#"{"unknown": 1}"#.to_vec(),
-        br#"{"pose": {"position": [1e308, 0, 0], "quaternion": [0,0,0,1]}}"#.to_vec(),
-    ]
 }
 
 /// Every hostile path as a robot, a grasp-type file, an object mesh and an obstacle

@@ -127,6 +127,20 @@ fn call_payload(query: &Query) -> Cow<'_, [u8]> {
 
 /// The refusal of a host-to-plugin command sent on the bus (`unknown_command`,
 /// naming the command and the role): only the host's world hub calls them.
+/// `error` marked `details.fallback: true`: the host's answer for a prefix it
+/// does not serve, which a caller sets aside when the prefix's own component
+/// answers too (`tsukami_bus::client::query`).
+fn as_fallback(mut error: ErrorReply) -> ErrorReply {
+    let details = error
+        .error
+        .details
+        .get_or_insert_with(|| serde_json::json!({}));
+    if let Some(map) = details.as_object_mut() {
+        map.insert("fallback".into(), true.into());
+    }
+    error
+}
+
 fn host_only(role: &str, command: &str) -> ErrorReply {
     ErrorReply::new(
         ErrorCode::UnknownCommand,
@@ -466,9 +480,10 @@ impl RunningHost {
     /// fills, an unknown role, an absent component: answered with `no_plugin`
     /// naming the role (`details.role`); a garbage payload still gets
     /// `malformed_json` / `invalid_request`. A served prefix is left to its own
-    /// queryable. Declared not complete. Where a component serves its own
-    /// `<prefix>/stop`, Tsukami's callers (target `All`) get both answers and keep
-    /// the component's: a `no_plugin` stands aside (`tsukami_bus::client::query`).
+    /// queryable. Declared not complete. Every answer is marked
+    /// `details.fallback: true`: where a component serves its own `<prefix>/stop`,
+    /// Tsukami's callers (target `All`) get both answers and keep the component's
+    /// (`tsukami_bus::client::query`), also for a payload the host would refuse.
     fn answer_stop_without_plugin(
         session: &zenoh::Session,
         keys: &KeySpace,
@@ -496,7 +511,7 @@ impl RunningHost {
                     )
                     .with_details(serde_json::json!({ "role": role }))
                 });
-                reply_error(&query, error);
+                reply_error(&query, as_fallback(error));
             })
             .wait()
             .map_err(|e| anyhow::anyhow!("declaring {key}: {e}"))

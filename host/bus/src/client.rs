@@ -197,9 +197,9 @@ impl BusClient {
 /// consolidation) and every reply is kept until all have answered or `timeout`
 /// passes. Exactly one reply is the answer (an error reply is
 /// [`RequestError::Reply`]); none is [`RequestError::Timeout`]; two or more are
-/// [`RequestError::Conflict`], naming the key and each reply. A host's `no_plugin`
-/// for a prefix it does not serve (its `<ns>/*/stop` fallback) stands aside when
-/// someone else answers.
+/// [`RequestError::Conflict`], naming the key and each reply. A `no_plugin`, and
+/// any answer of the host's `<ns>/*/stop` fallback for a prefix it does not serve
+/// (`details.fallback: true`), stands aside when someone else answers.
 pub fn query(
     session: &zenoh::Session,
     key: &str,
@@ -257,9 +257,18 @@ impl Answer {
         }
     }
 
-    /// A `no_plugin` error: "not mine", which yields to any other answer.
+    /// "Not mine", which yields to any other answer: a `no_plugin` error, or any
+    /// error the host's `<ns>/*/stop` fallback sends (`details.fallback: true`).
     fn stands_aside(&self) -> bool {
-        matches!(self, Answer::Error(e) if e.error.code == ErrorCode::NoPlugin)
+        let Answer::Error(e) = self else {
+            return false;
+        };
+        let fallback = e
+            .error
+            .details
+            .as_ref()
+            .is_some_and(|d| d["fallback"] == true);
+        e.error.code == ErrorCode::NoPlugin || fallback
     }
 
     /// What a person reads of it in a conflict.
@@ -329,6 +338,10 @@ mod tests {
         );
         let aside = decide("k", T, vec![no_plugin(), Answer::Value(b"2".to_vec())]);
         assert_eq!(aside.unwrap(), b"2");
+        let refused = ErrorReply::new(ErrorCode::MalformedJson, "x")
+            .with_details(serde_json::json!({"fallback": true}));
+        let fallback = vec![Answer::Error(refused), Answer::Value(b"3".to_vec())];
+        assert_eq!(decide("k", T, fallback).unwrap(), b"3");
         let alone = decide("k", T, vec![no_plugin(), Answer::ZenohTimeout]).unwrap_err();
         assert_eq!(alone.code(), Some(ErrorCode::NoPlugin));
         let none = decide("k", T, vec![Answer::ZenohTimeout]).unwrap_err();
