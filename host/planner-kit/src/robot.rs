@@ -339,6 +339,24 @@ impl Robot {
         })
     }
 
+    /// The closing joints of the hand's grasp type `grasp_type` (its
+    /// contacts' `joint`s, in the type's order); none for a type it does not
+    /// list.
+    pub fn closing_joints(&self, grasp_type: &str) -> Vec<JointId> {
+        self.hand()
+            .grasp_types
+            .grasp_types
+            .iter()
+            .find(|g| g.name == grasp_type)
+            .map(|g| {
+                g.contacts
+                    .iter()
+                    .filter_map(|c| self.model.joint_id(&c.joint).ok())
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+
     /// The hand planners use: the description's first.
     pub fn hand(&self) -> &Hand {
         &self.hands[0]

@@ -260,31 +260,9 @@ pub fn robustness<P: GraspPlanner>(
         object: world.object,
         length: grasp_length(world, grasp),
         palm_approach: rule.palm_contact.then_some(rule.approach),
-        closing: closing_joints(world, grasp),
+        closing: world.robot.closing_joints(&grasp.grasp_type.name),
     };
     pose_robustness(&problem, &grasp.q, &grasp.contacts, req, seed)
-}
-
-/// The closing joints of the grasp's type in the hand's grasp-type file
-/// (none for a type it does not list).
-fn closing_joints<P: GraspPlanner>(
-    world: &World<'_, P>,
-    grasp: &Grasp,
-) -> Vec<tsukami_body::model::JointId> {
-    let model = &world.robot.model;
-    world
-        .hand()
-        .grasp_types
-        .grasp_types
-        .iter()
-        .find(|g| g.name == grasp.grasp_type.name)
-        .map(|g| {
-            g.contacts
-                .iter()
-                .filter_map(|c| model.joint_id(&c.joint).ok())
-                .collect()
-        })
-        .unwrap_or_default()
 }
 
 /// The characteristic length of `grasp`: its own when valid, else the object's.

@@ -265,7 +265,7 @@ pub fn resolve(
         hand: hand.joints.clone(),
         open: closed.clone(),
         flex: opening_joints(robot, grasp),
-        closing: closing_joints(robot, grasp),
+        closing: robot.closing_joints(&grasp.grasp_type.name),
         squeeze: crate::squeeze::targets(model, &hand.joints, &grasp.squeeze)?,
         closed,
         palm,
@@ -306,22 +306,6 @@ impl Goal {
         }
         model.apply_mimics(&mut self.open);
     }
-}
-
-/// [`Goal::closing`]: the grasp type's contacts' closing joints, in order.
-fn closing_joints(robot: &Robot, grasp: &MotionGrasp) -> Vec<JointId> {
-    let hand = robot.hand();
-    hand.grasp_types
-        .grasp_types
-        .iter()
-        .find(|g| g.name == grasp.grasp_type.name)
-        .map(|g| {
-            g.contacts
-                .iter()
-                .filter_map(|c| robot.model.joint_id(&c.joint).ok())
-                .collect()
-        })
-        .unwrap_or_default()
 }
 
 /// [`Goal::flex`]: the flex joints straight, then the grasp type's other
