@@ -26,7 +26,8 @@ use tsukami_e2e::{
     TestBus,
 };
 use tsukami_msgs::controller::{ControllerState, ExecuteReply, ExecutionOutcome};
-use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER};
+use tsukami_msgs::keys::{planner, ROLE_GRASP_PLANNER, ROLE_TRAJECTORY_PLANNER};
+use tsukami_msgs::motion::MotionExecuteReply;
 use tsukami_msgs::motion::{JointTrajectory, TrajectoryPoint};
 use tsukami_msgs::vision::ObjectPose;
 use tsukami_msgs::Pose;
@@ -184,17 +185,21 @@ fn spawn_controller(t: &Topology) -> ChildGuard {
 }
 
 fn spawn_host(t: &Topology) -> ChildGuard {
+    spawn_host_with(t, &[("grasp-planner", "tsukami_grasp_planner")])
+}
+
+/// `tsukami run` over `t` with the plugins `(role, library)`.
+fn spawn_host_with(t: &Topology, plugins: &[(&str, &str)]) -> ChildGuard {
     let config = t.dir.join("host.toml");
-    std::fs::write(
-        &config,
-        format!(
-            "namespace = \"{}\"\n\n[[plugin]]\nrole = \"grasp-planner\"\npath = {:?}\n[plugin.config]\nmodels_dir = {:?}\n",
-            t.namespace,
-            plugin_file("tsukami_grasp_planner"),
+    let mut text = format!("namespace = \"{}\"\n", t.namespace);
+    for (role, lib) in plugins {
+        text += &format!(
+            "\n[[plugin]]\nrole = \"{role}\"\npath = {:?}\n[plugin.config]\nmodels_dir = {:?}\n",
+            plugin_file(lib),
             models_dir()
-        ),
-    )
-    .unwrap();
+        );
+    }
+    std::fs::write(&config, text).unwrap();
     let mut args = vec![
         "run",
         "--config",
@@ -450,6 +455,80 @@ fn vision_plan_and_controller_peer_to_peer() {
 #[test]
 fn vision_plan_and_controller_through_a_router() {
     vision_plan_execute_kill_restart(through_router());
+}
+
+/// `motion/execute` on a real controller: the can at breast height is
+/// planned, then one call plans its motion from the controller's state and runs
+/// it; the reply carries the motion and the controller's outcome, and the
+/// controller ends at the motion's last point.
+#[test]
+fn motion_execute_plans_and_runs_on_the_controller() {
+    let t = peer_to_peer();
+    let _host = spawn_host_with(
+        &t,
+        &[
+            ("grasp-planner", "tsukami_grasp_planner"),
+            ("trajectory-planner", "tsukami_trajectory_planner"),
+        ],
+    );
+    let _controller = spawn_controller(&t);
+    let client = BusClient::connect(&t.client, &t.namespace).unwrap();
+    client.wait_for_host(T).unwrap();
+    client.wait_for_component("controller", T).unwrap();
+    let scene = tsukami_scenes::paper_scene("can_breast").unwrap();
+    let outcome = tsukami::scenes::run_scene(&client, &models_dir(), scene, 0, T);
+    let grasp = outcome.result.expect("the can is grasped");
+    let request =
+        serde_json::json!({ "plan": { "grasp": grasp, "seed": 1, "retreat_distance": 0.05 } });
+    let bytes = client
+        .command(
+            ROLE_TRAJECTORY_PLANNER,
+            "execute",
+            request.to_string().as_bytes(),
+            T,
+        )
+        .expect("motion/execute answers");
+    let reply: MotionExecuteReply = serde_json::from_slice(&bytes).unwrap();
+    assert_eq!(reply.plan.start_source, "controller");
+    let mut phases: Vec<&str> = reply
+        .plan
+        .trajectory
+        .points
+        .iter()
+        .map(|p| p.phase.as_str())
+        .collect();
+    phases.dedup();
+    assert_eq!(phases, ["reach", "approach", "close", "lift", "retreat"]);
+    let run = &reply.execution;
+    assert!(run.accepted, "{:?}", run.reason);
+    assert_eq!(run.outcome, Some(ExecutionOutcome::Done));
+    let end = run.state.as_ref().expect("the final state");
+    let t = &reply.plan.trajectory;
+    let last = t.points.last().unwrap();
+    for (k, name) in t.joint_names.iter().enumerate() {
+        let i = end.joint_names.iter().position(|n| n == name).unwrap();
+        assert!(
+            (end.positions[i] - last.positions[k]).abs() < 1e-6,
+            "{name}"
+        );
+        // The squeezed fingers stay commanded beyond contact.
+        let commanded = last.command.get(k).unwrap_or(&last.positions[k]);
+        assert!(
+            (end.commanded[i] - commanded).abs() < 1e-6,
+            "{name} commanded"
+        );
+    }
+    // A bad request names its field; the plugin keeps serving.
+    let bad = serde_json::json!({ "plan": { "grasp": grasp, "retreat_distance": 1.0 } });
+    let e = client
+        .command(
+            ROLE_TRAJECTORY_PLANNER,
+            "execute",
+            bad.to_string().as_bytes(),
+            T,
+        )
+        .unwrap_err();
+    assert!(format!("{e:?}").contains("retreat_distance"), "{e:?}");
 }
 
 #[test]

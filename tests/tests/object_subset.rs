@@ -40,13 +40,19 @@ const SUBSET: [(&str, &str); 14] = [
     ("mug_1", "counter_1.00_rotated"),
     ("low_0", "table_0.78"),
     ("cone_1", "shelf_0.60"),
-    ("torus_1", "stool_0.45"),
+    ("torus_1", "table_0.78"),
     ("low_0", "counter_1.00_rotated"),
     ("low_3", "shelf_0.60"),
 ];
 
-/// The cases of [`SUBSET`] no approach along the object box's axes holds.
-const TILTED: [(&str, &str); 2] = [("low_0", "counter_1.00_rotated"), ("low_3", "shelf_0.60")];
+/// The cases of [`SUBSET`] no approach along the object box's axes holds —
+/// or, for the cone under the shelf's board, none whose approach, closing and
+/// lift are free (the grasp planner checks them, issue #23).
+const TILTED: [(&str, &str); 3] = [
+    ("low_0", "counter_1.00_rotated"),
+    ("low_3", "shelf_0.60"),
+    ("cone_1", "shelf_0.60"),
+];
 
 /// A temporary model root, removed on drop.
 struct TempRoot(PathBuf);

@@ -52,6 +52,8 @@ pub const BENCHES: &[Bench] = &[
     Bench { name: "object_bench", program: "cargo", args: &["run", "--release", "-p", "tsukami-grasp-planner", "--example", "object_bench"] },
     Bench { name: "physics", program: "bash", args: &["bench/physics/ci.sh"] },
     Bench { name: "motion_scenes", program: "cargo", args: &["bench", "-p", "tsukami-trajectory-planner", "--bench", "motion_scenes"] },
+    Bench { name: "toppra", program: "bash", args: &["bench/toppra/run.sh"] },
+    Bench { name: "object_motions", program: "cargo", args: &["run", "--release", "-p", "tsukami-trajectory-planner", "--example", "object_motions"] },
     Bench { name: "vision", program: "cargo", args: &["bench", "-p", "tsukami-vision", "--bench", "vision"] },
     Bench { name: "build_time", program: "bash", args: &["bench/build_time.sh"] },
 ];

@@ -24,13 +24,19 @@ pub struct MotionPlanRequest {
     /// (0.005 to 0.3); the approach is a straight line from there to the grasp.
     #[serde(default = "default_pregrasp")]
     pub pregrasp_distance: f64,
+    /// After the lift, how far the palm moves straight back against the
+    /// approach vector, carrying the object (a `retreat` phase), metres (0 to
+    /// 0.3; 0, the default: no retreat).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub retreat_distance: f64,
     /// Seed of the reach planner's samples (same seed and world, same trajectory).
     #[serde(default)]
     pub seed: u64,
     /// Sample budget of the reach planner (RRT-Connect), 1 to the host's limit.
     #[serde(default = "default_motion_samples")]
     pub max_samples: u32,
-    /// Acceleration limit of every joint (rad/s² or m/s²); default: the plugin's
+    /// Acceleration limit of every joint (rad/s² or m/s²); default: each joint's
+    /// from the robot description's `[acceleration]` table, else the plugin's
     /// configured `acceleration`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_acceleration: Option<f64>,
@@ -41,8 +47,9 @@ pub struct MotionPlanRequest {
     /// version is refused (`invalid_value`, `details.reason = "world_changed"`).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub revalidate: bool,
-    /// Safety distances from the obstacles; default: the plugin's configured ones
-    /// (10 mm for every link but the hand's, 3 mm for the hand until `close`).
+    /// Safety distances from the obstacles; default: the robot description's
+    /// `[clearance]`, else the plugin's configured ones (10 mm for every link but
+    /// the hand's, 3 mm for the hand until `close`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clearance: Option<ClearanceRequest>,
 }
@@ -60,12 +67,24 @@ pub struct ClearanceRequest {
     pub hand: Option<f64>,
 }
 
+/// The default `lift_height` of a motion request (m); the grasp planner checks
+/// the lift a grasp implies over this height.
+pub const DEFAULT_LIFT_HEIGHT: f64 = 0.05;
+
+/// The default `pregrasp_distance` of a motion request (m); the grasp planner
+/// checks the approach a grasp implies over this distance.
+pub const DEFAULT_PREGRASP_DISTANCE: f64 = 0.05;
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
 fn default_lift() -> f64 {
-    0.05
+    DEFAULT_LIFT_HEIGHT
 }
 
 fn default_pregrasp() -> f64 {
-    0.05
+    DEFAULT_PREGRASP_DISTANCE
 }
 
 fn default_motion_samples() -> u32 {
@@ -130,8 +149,9 @@ pub struct MotionGraspType {
 #[serde(deny_unknown_fields)]
 pub struct MotionPlanReply {
     /// The trajectory, as `<ns>/controller/execute` takes it; every point's
-    /// `phase` is `reach`, `approach`, `close` or `lift`; when the grasp has a
-    /// `squeeze`, the last `close` point and every `lift` point carry `command`.
+    /// `phase` is `reach`, `approach`, `close`, `lift` or (when asked)
+    /// `retreat`; when the grasp has a `squeeze`, the last `close` point and
+    /// every `lift` and `retreat` point carry `command`.
     pub trajectory: JointTrajectory,
     /// Where the start came from: `request`, `controller` or `rest` (joints the
     /// request named come from it in every case).
@@ -148,6 +168,35 @@ pub struct MotionPlanReply {
     /// trajectory's points, and where; absent when the world has no obstacle.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clearance: Option<ClearanceReport>,
+}
+
+/// Request of `<ns>/motion/execute`: plan a motion and hand it to the
+/// controller (`<ns>/controller/execute`) in one call.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct MotionExecuteRequest {
+    /// The motion to plan, as `<ns>/motion/plan` takes it.
+    pub plan: MotionPlanRequest,
+    /// Reply when the run ends (`true`, the default: the reply carries the
+    /// outcome and the final state) or as soon as the controller accepts the
+    /// trajectory (`false`).
+    #[serde(default = "default_true")]
+    pub wait: bool,
+}
+
+fn default_true() -> bool {
+    true
+}
+
+/// Reply of `<ns>/motion/execute`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct MotionExecuteReply {
+    /// The planned motion, as `<ns>/motion/plan` replies it.
+    pub plan: MotionPlanReply,
+    /// The controller's reply to the trajectory (accepted or not, and with
+    /// `wait` the outcome and the final state).
+    pub execution: crate::controller::ExecuteReply,
 }
 
 /// Where a motion comes nearest to the obstacles.

@@ -29,6 +29,8 @@ pub fn all() -> Vec<NamedSchema> {
         named::<crate::host::StopReply>("stop_reply"),
         named::<crate::motion::MotionPlanRequest>("motion_plan_request"),
         named::<crate::motion::MotionPlanReply>("motion_plan_reply"),
+        named::<crate::motion::MotionExecuteRequest>("motion_execute_request"),
+        named::<crate::motion::MotionExecuteReply>("motion_execute_reply"),
         named::<crate::motion::MotionProgress>("motion_progress"),
         named::<crate::motion::JointTrajectory>("joint_trajectory"),
         named::<crate::controller::ExecuteRequest>("controller_execute_request"),

@@ -96,6 +96,38 @@ fn default_servo_saturation() -> f64 {
     0.2
 }
 
+/// Joint acceleration limits (rad/s², m/s² for prismatic joints), which a
+/// URDF cannot state (MoveIt keeps them in `joint_limits.yaml`). Motions are
+/// timed within them.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AccelerationSpec {
+    /// Every joint not named otherwise; none: the trajectory planner's
+    /// configured `acceleration`.
+    #[serde(default)]
+    pub default: Option<f64>,
+    /// Every joint of the hands (below the palm).
+    #[serde(default)]
+    pub hand: Option<f64>,
+    /// Joints by name, over the two above.
+    #[serde(default)]
+    pub joints: std::collections::BTreeMap<String, f64>,
+}
+
+/// Safety distances this robot's motions keep from the obstacles (m); a
+/// motion request's `clearance` overrides them, and without them the
+/// trajectory planner's configured ones apply (10 mm, 3 mm).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClearanceSpec {
+    /// Every link but the hand's, in every phase.
+    #[serde(default)]
+    pub body: Option<f64>,
+    /// The hand's links in the reach and the approach.
+    #[serde(default)]
+    pub hand: Option<f64>,
+}
+
 /// A robot description file.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -117,6 +149,12 @@ pub struct Description {
     /// palm box. Default none.
     #[serde(default)]
     pub allowed_collisions: Vec<[String; 2]>,
+    /// Joint acceleration limits (default: none stated).
+    #[serde(default)]
+    pub acceleration: AccelerationSpec,
+    /// Safety distances of this robot's motions (default: none stated).
+    #[serde(default)]
+    pub clearance: ClearanceSpec,
 }
 
 impl Description {
@@ -159,6 +197,29 @@ impl Description {
                 return Err(bad(key("servo_saturation"), "must be in (0, 3]"));
             }
         }
+        let a = &self.acceleration;
+        let named = a
+            .joints
+            .iter()
+            .map(|(j, v)| (format!("acceleration.joints.{j}"), *v));
+        let groups = [
+            ("acceleration.default", a.default),
+            ("acceleration.hand", a.hand),
+        ]
+        .into_iter()
+        .filter_map(|(k, v)| v.map(|v| (k.to_owned(), v)));
+        if let Some((k, _)) = groups
+            .chain(named)
+            .find(|(_, v)| !(v.is_finite() && *v > 0.0 && *v <= 1e4))
+        {
+            return Err(bad(k, "must be in (0, 10000] rad/s² (or m/s²)"));
+        }
+        let c = &self.clearance;
+        for (k, v) in [("clearance.body", c.body), ("clearance.hand", c.hand)] {
+            if v.is_some_and(|v| !(v.is_finite() && (0.0..=0.1).contains(&v))) {
+                return Err(bad(k.into(), "must be 0 to 0.1 m"));
+            }
+        }
         Ok(())
     }
 }
@@ -194,5 +255,20 @@ mod tests {
         "#;
         let e = Description::parse(text, "d.toml").unwrap_err();
         assert!(e.to_string().contains("hand[0].wrist"), "{e}");
+        let ok = text.replace("wrist = [\"b\"]", "wrist = [\"a\"]");
+        for (extra, key) in [
+            ("[acceleration]\nhand = -1.0\n", "acceleration.hand"),
+            (
+                "[acceleration]\njoints = { a = 0.0 }\n",
+                "acceleration.joints.a",
+            ),
+            ("[clearance]\nbody = 0.5\n", "clearance.body"),
+        ] {
+            let e = Description::parse(&format!("{ok}\n{extra}"), "d.toml").unwrap_err();
+            assert!(e.to_string().contains(key), "{e}");
+        }
+        let d =
+            Description::parse(&format!("{ok}\n[clearance]\nhand = 0.005\n"), "d.toml").unwrap();
+        assert_eq!((d.clearance.hand, d.clearance.body), (Some(0.005), None));
     }
 }

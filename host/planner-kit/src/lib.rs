@@ -22,6 +22,8 @@
 //!   re-verified (exact force closure with the object's weight) before it leaves;
 //! - **building blocks** ([`blocks`]): finger closing, finger force, collision
 //!   passes, whole-body IK stages — call them or not;
+//! - **motion checks** ([`motion_check`]): the approach, closing and lift of a
+//!   grasp checked as the trajectory planner will take them;
 //! - **a conformance suite** ([`conformance`]) any planner plugin runs.
 //!
 //! `docs/plugins.md` walks through a planner with
@@ -62,6 +64,7 @@ pub mod grasp_derive;
 pub mod grasp_types;
 pub mod mesh_topology;
 pub mod models;
+pub mod motion_check;
 pub mod object;
 pub mod planner;
 pub mod plugin;

@@ -103,6 +103,11 @@ pub struct Robot {
     pub whole_body: Vec<JointId>,
     /// The description file, relative to its model root.
     pub description_name: String,
+    /// Per joint (by id), its acceleration limit from the description's
+    /// `[acceleration]` table, if it states one.
+    pub acceleration: Vec<Option<f64>>,
+    /// The description's safety distances, if it states them.
+    pub clearance: crate::description::ClearanceSpec,
 }
 
 fn below(model: &RobotModel, root: LinkId) -> Vec<LinkId> {
@@ -113,6 +118,33 @@ fn below(model: &RobotModel, root: LinkId) -> Vec<LinkId> {
         k += 1;
     }
     out
+}
+
+/// The description's acceleration limits per joint id: a named joint's own,
+/// else the hand's for a joint below a palm, else the default.
+fn accelerations(
+    model: &RobotModel,
+    hands: &[Hand],
+    spec: &crate::description::AccelerationSpec,
+) -> Result<Vec<Option<f64>>, KitError> {
+    let mut out: Vec<Option<f64>> = (0..model.joints.len())
+        .map(|j| {
+            let in_hand = hands
+                .iter()
+                .any(|h| h.links.contains(&model.joints[j].child));
+            if in_hand {
+                spec.hand.or(spec.default)
+            } else {
+                spec.default
+            }
+        })
+        .collect();
+    for (name, &v) in &spec.joints {
+        let key = format!("acceleration.joints.{name}");
+        let j = ids(model, std::slice::from_ref(name), &key)?[0];
+        out[j] = Some(v);
+    }
+    Ok(out)
 }
 
 fn ids(model: &RobotModel, names: &[String], key: &str) -> Result<Vec<JointId>, KitError> {
@@ -330,12 +362,15 @@ impl Robot {
         }
         let waist = ids(&model, &description.waist, "waist")?;
         let whole_body = ids(&model, &description.whole_body, "whole_body")?;
+        let acceleration = accelerations(&model, &hands, &description.acceleration)?;
         Ok(Robot {
             model,
             hands,
             waist,
             whole_body,
             description_name: file.name().to_owned(),
+            acceleration,
+            clearance: description.clearance,
         })
     }
 

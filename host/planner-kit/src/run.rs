@@ -38,6 +38,7 @@ use std::time::{Duration, Instant};
 
 use tsukami_msgs::planner::{HoldRequest, PhaseTiming, PlanPhase, PoseRobustness, ProgressEvent};
 
+use crate::motion_check::phases::Blocked;
 use crate::planner::{GraspPlanner, World};
 use crate::{Grasp, Stop};
 
@@ -85,6 +86,8 @@ pub struct Run<'a> {
     tried: Vec<String>,
     /// The last pose-robustness answer and what it was asked of.
     robust_memo: Option<RobustMemo>,
+    /// The last motion-phase answer and the grasp it was asked of.
+    phase_memo: Option<(Grasp, Result<(), Blocked>)>,
 }
 
 /// A grasp, the request and seed it was re-checked under, and the answer.
@@ -117,6 +120,7 @@ impl<'a> Run<'a> {
             joints_used: Vec::new(),
             tried: Vec::new(),
             robust_memo: None,
+            phase_memo: None,
         }
     }
 
@@ -138,6 +142,25 @@ impl<'a> Run<'a> {
         }
         let answer = crate::verify::robustness(world, grasp, req, seed);
         self.robust_memo = Some((grasp.clone(), *req, seed, answer));
+        answer
+    }
+
+    /// Whether the approach, closing and lift `grasp` implies are free
+    /// ([`crate::verify::motion_phases`]). The last answer is kept, so the
+    /// session's check of the grasp a planner chose on it does not repeat the
+    /// work.
+    pub fn motion_phases<P: GraspPlanner>(
+        &mut self,
+        world: &World<'_, P>,
+        grasp: &Grasp,
+    ) -> Result<(), Blocked> {
+        if let Some((g, answer)) = &self.phase_memo {
+            if g == grasp {
+                return answer.clone();
+            }
+        }
+        let answer = crate::verify::motion_phases(world, grasp);
+        self.phase_memo = Some((grasp.clone(), answer.clone()));
         answer
     }
 

@@ -244,6 +244,9 @@ impl<P: GraspPlanner> Session<P> {
             Ok(grasp) => {
                 let mut verdict =
                     verify(&world, &grasp, &opts.hold).map_err(KitError::Unverified)?;
+                run.motion_phases(&world, &grasp).map_err(|b| {
+                    KitError::Unverified(format!("the grasp cannot be executed: {b}"))
+                })?;
                 verdict.robustness = run.pose_robustness(&world, &grasp, &opts.hold, opts.seed);
                 let (timing, tried, samples) = run.finish();
                 let report = RunReport {

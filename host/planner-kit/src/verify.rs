@@ -22,7 +22,9 @@
 //! the object or an obstacle, no two links overlapping but adjacent and
 //! allowed pairs, contacts on the surface with agreeing normals:
 //! [`crate::blocks::grasp_check`], the same rules the paper's planner applies
-//! to its candidates), then the force-closure step.
+//! to its candidates), then the force-closure step. The session then checks
+//! the grasp's approach, closing and lift ([`motion_phases`], the trajectory
+//! planner's own checks, `crate::motion_check::phases`).
 
 use nalgebra::Vector3;
 use tsukami_grasp::contact::Contact;
@@ -40,6 +42,8 @@ use crate::blocks::hold::{
 use crate::blocks::robust::{pose_robustness, RobustProblem};
 use crate::blocks::wrap::{style_check, StyleRule};
 use crate::grasp::{FingerContact, Grasp};
+use crate::motion_check::goal::Goal;
+use crate::motion_check::phases::{check_phases, Blocked, PhaseParams, PhaseScene};
 use crate::object::Object;
 use crate::planner::{GraspPlanner, World};
 use tsukami_msgs::planner::{DisturbanceSet, HoldRequest, JointSqueeze, PoseRobustness};
@@ -331,4 +335,27 @@ fn hold_checks<P: GraspPlanner>(
     );
     verdict.squeeze = s.ok_or("no squeeze the joints can make balances the contacts")?;
     Ok(())
+}
+
+/// The approach, closing and lift `grasp` implies, checked as the trajectory
+/// planner will plan them ([`crate::motion_check::phases`], default settings:
+/// the motion request's default pre-grasp distance and lift height, the
+/// robot description's clearances or else the default ones): the reach moves the grasp's extra joints and the arm,
+/// the palm comes in along the grasp type's approach. Planners call it
+/// through [`crate::Run::motion_phases`]; the session calls it on every grasp
+/// a planner returns.
+pub fn motion_phases<P: GraspPlanner>(world: &World<'_, P>, grasp: &Grasp) -> Result<(), Blocked> {
+    let robot = world.robot;
+    let name = &grasp.grasp_type.name;
+    let approach = Goal::type_approach(robot, name, &grasp.q).ok_or_else(|| Blocked {
+        reason: "unknown_grasp_type",
+        message: format!("the hand has no grasp type `{name}`, so the grasp has no approach"),
+    })?;
+    let mut reach = grasp.extra.clone();
+    reach.extend(robot.hand().arm.iter().filter(|j| !grasp.extra.contains(j)));
+    let goal = Goal::new(robot, grasp.q.clone(), reach, name, approach);
+    let mut params = PhaseParams::default();
+    params.clearance = params.clearance.for_robot(robot);
+    let mut scene = PhaseScene::new(robot, world.object, world.obstacles.clone(), goal, params);
+    check_phases(&mut scene).map(|_| ())
 }

@@ -353,7 +353,8 @@ impl Paper {
                     &mut t.counters,
                     &mut |found| {
                         let g = grasp(g.to_ref(), &nom.candidate, &stage, found.clone(), object);
-                        run.pose_robustness(w, &g, &opts.hold, opts.seed)
+                        run.motion_phases(w, &g).map_err(|b| b.to_string())?;
+                        Ok(run.pose_robustness(w, &g, &opts.hold, opts.seed))
                     },
                 );
                 run.record(t.counters.samples, t.counters.best_margin);

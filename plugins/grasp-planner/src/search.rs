@@ -155,7 +155,7 @@ pub enum Outcome {
 }
 
 /// The reasons a sample is rejected, in the order of [`Counters::rejections`].
-pub const REJECTION_REASONS: [&str; 9] = [
+pub const REJECTION_REASONS: [&str; 10] = [
     "ik",
     "collision before closing",
     "finger closing",
@@ -165,6 +165,7 @@ pub const REJECTION_REASONS: [&str; 9] = [
     "no wrap",
     "pose error",
     "too compliant",
+    "motion blocked",
 ];
 
 /// Samples a search goes on drawing, after its first accepted grasp that
@@ -183,7 +184,7 @@ pub struct Counters {
     /// Best ellipsoid margin seen.
     pub best_margin: Option<f64>,
     /// Why samples were rejected, per [`REJECTION_REASONS`].
-    pub rejections: [u32; 9],
+    pub rejections: [u32; 10],
     /// What blocked the collision-rejected samples: `"<link> vs <obstacle>"`
     /// (or `"… vs <link>"` for self-collision) with counts.
     pub blockers: BTreeMap<String, u32>,
@@ -215,14 +216,17 @@ impl Counters {
     }
 }
 
-/// The re-check of an accepted grasp under the request's object pose errors
-/// (the kit's, `tsukami_planner_kit::Run::pose_robustness`): how many it
-/// still holds under.
-pub type Robustness<'h> = dyn FnMut(&Found) -> PoseRobustness + 'h;
+/// What the kit says of an accepted grasp before the search keeps it
+/// (`tsukami_planner_kit::Run`): `Err` (why) when the approach, closing or lift
+/// it implies is blocked (`Run::motion_phases`, the trajectory planner's
+/// checks), else how many of the request's object pose errors it still holds
+/// under (`Run::pose_robustness`).
+pub type Judge<'h> = dyn FnMut(&Found) -> Result<PoseRobustness, String> + 'h;
 
 /// Algorithm 1 around one nominal pose. `q_nominal` is the nominal IK solution
-/// (full vector) for grasp type `t` over `stage`. The first accepted grasp
-/// that holds under every pose error is returned; one that some error drops
+/// (full vector) for grasp type `t` over `stage`. An accepted grasp whose
+/// approach, closing or lift is blocked is a rejection (`motion blocked`). The
+/// first accepted grasp that holds under every pose error is returned; one that some error drops
 /// is kept while the search goes on for at most [`ROBUST_EXTRA_SAMPLES`]
 /// samples, and the one that held under the most (the first of equals) is
 /// returned then.
@@ -235,7 +239,7 @@ pub fn search(
     q_nominal: &[f64],
     seed: u64,
     counters: &mut Counters,
-    robustness: &mut Robustness<'_>,
+    judge: &mut Judge<'_>,
 ) -> Outcome {
     let mut best: Option<Box<Found>> = None;
     let stop_at = Cell::new(u32::MAX);
@@ -246,7 +250,13 @@ pub fn search(
         seed,
         counters,
         &mut |found, at, counters| {
-            let r = robustness(&found);
+            let r = match judge(&found) {
+                Ok(r) => r,
+                Err(why) => {
+                    counters.reject(9, Some(why));
+                    return None;
+                }
+            };
             let found = Box::new(Found {
                 robustness: r,
                 ..found

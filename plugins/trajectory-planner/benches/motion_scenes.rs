@@ -47,11 +47,12 @@ fn times(
             start: w.robot.model.rest_positions(),
             lift_height: 0.05,
             pregrasp_distance: 0.05,
+            retreat_distance: 0.0,
             seed,
             max_samples: 5000,
             recheck: false,
             clearance: tsukami_trajectory_planner::motion::Clearance::default(),
-            acceleration: cfg.acceleration,
+            acceleration: None,
         };
         let t = Instant::now();
         let r = plan_motion(

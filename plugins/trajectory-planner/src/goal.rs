@@ -33,42 +33,14 @@ use tsukami_msgs::motion::MotionGrasp;
 use tsukami_planner_kit::validate::{self, Limits};
 use tsukami_planner_kit::Robot;
 
+pub use tsukami_planner_kit::motion_check::goal::Goal;
+
 use crate::error::MotionError;
 
 /// How far the request's palm pose may be from the one its joint positions give.
 pub const PALM_POSITION_TOLERANCE: f64 = 0.005;
 /// The same for the orientation, rad.
 pub const PALM_ANGLE_TOLERANCE: f64 = 0.05;
-
-/// The grasp a motion ends in, resolved against the robot.
-#[derive(Debug, Clone)]
-pub struct Goal {
-    /// Joints the reach, approach and lift move: body joints, then the arm.
-    pub reach: Vec<JointId>,
-    /// The hand's independent joints.
-    pub hand: Vec<JointId>,
-    /// The grasp posture, hand closed (full joint vector).
-    pub closed: Vec<f64>,
-    /// The grasp posture, hand open (see [`Goal::open_by`]).
-    pub open: Vec<f64>,
-    /// The joints that open the hand and their fully open values: the
-    /// fingers' flex joints (straight: 0, clamped into the limits) and the
-    /// grasp type's closing joints that are not flex joints (e.g. a thumb's
-    /// opposition), at the type's reference posture, where the grasp
-    /// planner's closing started.
-    pub flex: Vec<(JointId, f64)>,
-    /// The palm pose at the grasp (forward kinematics of `closed`).
-    pub palm: Isometry3<f64>,
-    /// Unit direction the palm moves in along the approach (world frame).
-    pub approach: Vector3<f64>,
-    /// The grasp type's closing joints (its contacts' `joint`s, in the
-    /// type's order: the order the grasp planner closed them); empty for a
-    /// type the robot does not know.
-    pub closing: Vec<JointId>,
-    /// The grasp's squeeze: each squeezed hand joint and its target
-    /// ([`crate::squeeze::targets`]); empty when the grasp has none.
-    pub squeeze: Vec<(JointId, f64)>,
-}
 
 fn joint_value(
     model: &RobotModel,
@@ -259,81 +231,9 @@ pub fn resolve(
         ));
     }
     let reach = reach_joints(robot, grasp, &set, start, &closed)?;
-    let mut goal = Goal {
-        approach: approach_direction(robot, grasp, &palm)?,
-        reach,
-        hand: hand.joints.clone(),
-        open: closed.clone(),
-        flex: opening_joints(robot, grasp),
-        closing: robot.closing_joints(&grasp.grasp_type.name),
-        squeeze: crate::squeeze::targets(model, &hand.joints, &grasp.squeeze)?,
-        closed,
-        palm,
-    };
-    goal.open_by(model, 1.0);
+    let approach = approach_direction(robot, grasp, &palm)?;
+    let squeeze = crate::squeeze::targets(model, &hand.joints, &grasp.squeeze)?;
+    let mut goal = Goal::new(robot, closed, reach, &grasp.grasp_type.name, approach);
+    goal.squeeze = squeeze;
     Ok(goal)
-}
-
-impl Goal {
-    /// The closing in the grasp planner's order, from the current opening:
-    /// first every opened joint but the type's closing joints back at the
-    /// grasp's angles (the pre-shape), then each closing joint in turn; the
-    /// postures after each step (the last is `closed`).
-    pub fn sequential_close(&self, model: &RobotModel) -> Vec<Vec<f64>> {
-        let mut q = self.open.clone();
-        for &(j, _) in &self.flex {
-            if !self.closing.contains(&j) {
-                q[j] = self.closed[j];
-            }
-        }
-        model.apply_mimics(&mut q);
-        let mut out = vec![q.clone()];
-        for &j in &self.closing {
-            q[j] = self.closed[j];
-            model.apply_mimics(&mut q);
-            out.push(q.clone());
-        }
-        out.push(self.closed.clone());
-        out
-    }
-
-    /// Opens the hand by `opening` (1: every flex joint at 0, clamped into its
-    /// limits; 0: the grasp's angles; linear between).
-    pub fn open_by(&mut self, model: &RobotModel, opening: f64) {
-        self.open.clone_from(&self.closed);
-        for &(j, open) in &self.flex {
-            self.open[j] = self.closed[j] + opening * (open - self.closed[j]);
-        }
-        model.apply_mimics(&mut self.open);
-    }
-}
-
-/// [`Goal::flex`]: the flex joints straight, then the grasp type's other
-/// closing joints at its reference posture (a type the robot does not know
-/// adds none; [`approach_direction`] names it).
-fn opening_joints(robot: &Robot, grasp: &MotionGrasp) -> Vec<(JointId, f64)> {
-    let (model, hand) = (&robot.model, robot.hand());
-    let mut out: Vec<(JointId, f64)> = hand
-        .fingers
-        .iter()
-        .flat_map(|f| f.flex.iter().copied())
-        .map(|j| {
-            let lim = model.joints[j].limits;
-            (j, 0.0f64.clamp(lim.lower, lim.upper))
-        })
-        .collect();
-    let types = &hand.grasp_types.grasp_types;
-    let Some(g) = types.iter().find(|g| g.name == grasp.grasp_type.name) else {
-        return out;
-    };
-    for c in &g.contacts {
-        let (Ok(j), Some(&v)) = (model.joint_id(&c.joint), g.posture.get(&c.joint)) else {
-            continue;
-        };
-        if !out.iter().any(|&(k, _)| k == j) {
-            let lim = model.joints[j].limits;
-            out.push((j, v.clamp(lim.lower, lim.upper)));
-        }
-    }
-    out
 }

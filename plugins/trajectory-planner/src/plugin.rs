@@ -22,15 +22,18 @@
 //! Config keys (beside the kit's `model_roots`, `limits`, `max_samples`):
 //! `acceleration`, `default_velocity`, `sample_dt`, `max_travel`,
 //! `touch_tolerance`, `shortcut_attempts`, `controller_timeout_ms`,
-//! `clearance_body`, `clearance_hand` (m; a request's `clearance` overrides them).
+//! `clearance_body`, `clearance_hand` (m; a request's `clearance` overrides them),
+//! `blend_deviation` (joint units, 0 to 0.5; 0: stop at every waypoint).
 
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
-use tsukami_msgs::controller::ControllerState;
+use tsukami_msgs::controller::{ControllerState, ExecuteReply, ExecuteRequest};
 use tsukami_msgs::error::parse_request;
 use tsukami_msgs::keys::ROLE_TRAJECTORY_PLANNER;
-use tsukami_msgs::motion::{MotionPlanReply, MotionPlanRequest, MotionProgress};
+use tsukami_msgs::motion::{
+    MotionExecuteReply, MotionExecuteRequest, MotionPlanReply, MotionPlanRequest, MotionProgress,
+};
 use tsukami_planner_kit::{PlannerConfig, Session};
 use tsukami_plugin_api::{CallContext, CallError, Host, Plugin, PluginInfo};
 
@@ -80,6 +83,7 @@ pub fn motion_config(table: &toml::Table) -> Result<(MotionConfig, Duration), St
         sample_dt: number(&mut t, "sample_dt", d.sample_dt, (1e-3, 1.0))?,
         max_travel: number(&mut t, "max_travel", d.max_travel, (1e-4, 0.005))?,
         touch_tolerance: number(&mut t, "touch_tolerance", d.touch_tolerance, (0.0, 0.005))?,
+        blend_deviation: number(&mut t, "blend_deviation", d.blend_deviation, (0.0, 0.5))?,
         clearance: Clearance {
             body: number(&mut t, "clearance_body", d.clearance.body, (0.0, 0.1))?,
             hand: number(&mut t, "clearance_hand", d.clearance.hand, (0.0, 0.1))?,
@@ -97,6 +101,26 @@ pub fn motion_config(table: &toml::Table) -> Result<(MotionConfig, Duration), St
         return Err(format!("plugin config: unknown key `{k}`"));
     }
     Ok((cfg, Duration::from_millis(timeout as u64)))
+}
+
+/// How long `execute` waits for the controller beyond the trajectory's
+/// duration (with `wait`) or for its acceptance (without).
+const EXECUTE_MARGIN: Duration = Duration::from_secs(10);
+
+/// A request of type `T` from `payload` (blank: `{}`), or the wire's error.
+fn parse<T: serde::de::DeserializeOwned>(payload: &[u8]) -> Result<T, CallError> {
+    let payload: &[u8] = if payload.iter().all(u8::is_ascii_whitespace) {
+        b"{}"
+    } else {
+        payload
+    };
+    parse_request(payload).map_err(|r| {
+        let mut e = CallError::new(r.error.code.as_str(), r.error.message);
+        if let Some(d) = r.error.details {
+            e.details_json = d.to_string();
+        }
+        e
+    })
 }
 
 impl TrajectoryPlugin {
@@ -131,10 +155,16 @@ impl TrajectoryPlugin {
         (q, "controller")
     }
 
-    fn check_values(&self, req: &MotionPlanRequest) -> Result<f64, MotionError> {
+    fn check_values(&self, req: &MotionPlanRequest) -> Result<Option<f64>, MotionError> {
         let in_range = |x: f64, lo: f64, hi: f64| x.is_finite() && (lo..=hi).contains(&x);
         if !in_range(req.lift_height, 0.0, 0.5) {
             return Err(MotionError::invalid("lift_height", "must be 0 to 0.5 m"));
+        }
+        if !in_range(req.retreat_distance, 0.0, 0.3) {
+            return Err(MotionError::invalid(
+                "retreat_distance",
+                "must be 0 to 0.3 m",
+            ));
         }
         if !in_range(req.pregrasp_distance, 0.005, 0.3) {
             return Err(MotionError::invalid(
@@ -149,19 +179,23 @@ impl TrajectoryPlugin {
                 format!("must be 1 to {most}"),
             ));
         }
-        let a = req.max_acceleration.unwrap_or(self.motion.acceleration);
-        if !in_range(a, 1e-3, 1e3) {
-            return Err(MotionError::invalid(
+        match req.max_acceleration {
+            Some(a) if !in_range(a, 1e-3, 1e3) => Err(MotionError::invalid(
                 "max_acceleration",
                 "must be 0.001 to 1000",
-            ));
+            )),
+            a => Ok(a),
         }
-        Ok(a)
     }
 
-    /// The request's clearances over the configured ones, each 0 to 0.1 m.
-    fn clearance(&self, req: &MotionPlanRequest) -> Result<Clearance, MotionError> {
-        let d = self.motion.clearance;
+    /// The request's clearances over the robot description's over the
+    /// configured ones, each 0 to 0.1 m.
+    fn clearance(
+        &self,
+        req: &MotionPlanRequest,
+        robot: &tsukami_planner_kit::Robot,
+    ) -> Result<Clearance, MotionError> {
+        let d = self.motion.clearance.for_robot(robot);
         let Some(c) = &req.clearance else {
             return Ok(d);
         };
@@ -177,19 +211,65 @@ impl TrajectoryPlugin {
     }
 
     fn plan(&self, payload: &[u8], ctx: &CallContext<'_>) -> Result<Vec<u8>, CallError> {
-        let t0 = Instant::now();
-        let payload: &[u8] = if payload.iter().all(u8::is_ascii_whitespace) {
-            b"{}"
-        } else {
-            payload
-        };
-        let req: MotionPlanRequest = parse_request(payload).map_err(|r| {
-            let mut e = CallError::new(r.error.code.as_str(), r.error.message);
-            if let Some(d) = r.error.details {
-                e.details_json = d.to_string();
+        let req: MotionPlanRequest = parse(payload)?;
+        let reply = self.plan_reply(&req, ctx)?;
+        serde_json::to_vec(&reply).map_err(|e| CallError::new("internal", e.to_string()))
+    }
+
+    /// `execute`: the motion of `plan`, then the controller's
+    /// `controller/execute` with it; the reply carries both answers.
+    fn execute(&self, payload: &[u8], ctx: &CallContext<'_>) -> Result<Vec<u8>, CallError> {
+        let req: MotionExecuteRequest = parse(payload)?;
+        let plan = self.plan_reply(&req.plan, ctx)?;
+        let progress = |phase: &str| {
+            let event = MotionProgress {
+                phase: phase.to_owned(),
+                samples: plan.samples,
+                elapsed_ms: plan.planning_ms,
+            };
+            if let Ok(bytes) = serde_json::to_vec(&event) {
+                ctx.host().progress(&bytes);
             }
-            e
+        };
+        progress("execute");
+        let duration = plan.trajectory.points.last().map_or(0.0, |p| p.time);
+        let timeout = match req.wait {
+            true => Duration::from_secs_f64(duration.min(3600.0)) + EXECUTE_MARGIN,
+            false => EXECUTE_MARGIN,
+        };
+        let request = ExecuteRequest {
+            trajectory: plan.trajectory.clone(),
+            wait: req.wait,
+        };
+        let bytes =
+            serde_json::to_vec(&request).map_err(|e| CallError::new("internal", e.to_string()))?;
+        let answer = self
+            .host
+            .request("controller/execute", &bytes, timeout)
+            .map_err(|mut e| {
+                e.message = format!(
+                    "the motion was planned (world version {}), but controller/execute failed: {}",
+                    plan.world_version, e.message
+                );
+                e
+            })?;
+        let execution: ExecuteReply = serde_json::from_slice(&answer).map_err(|e| {
+            CallError::new(
+                "internal",
+                format!("controller/execute replied something else: {e}"),
+            )
         })?;
+        progress("executed");
+        let reply = MotionExecuteReply { plan, execution };
+        serde_json::to_vec(&reply).map_err(|e| CallError::new("internal", e.to_string()))
+    }
+
+    fn plan_reply(
+        &self,
+        req: &MotionPlanRequest,
+        ctx: &CallContext<'_>,
+    ) -> Result<MotionPlanReply, CallError> {
+        let t0 = Instant::now();
         let snapshot = self.session.snapshot();
         let world = snapshot.world().map_err(|e| e.to_call_error())?;
         let version = world.version;
@@ -204,11 +284,12 @@ impl TrajectoryPlugin {
             start,
             lift_height: req.lift_height,
             pregrasp_distance: req.pregrasp_distance,
+            retreat_distance: req.retreat_distance,
             seed: req.seed,
             max_samples: req.max_samples as usize,
             acceleration,
             recheck,
-            clearance: self.clearance(&req).map_err(fail)?,
+            clearance: self.clearance(&req, world.robot).map_err(fail)?,
         };
         let cancel = ctx.cancel_flag();
         let host = ctx.host();
@@ -247,7 +328,7 @@ impl TrajectoryPlugin {
             world_version: version,
             clearance,
         };
-        serde_json::to_vec(&reply).map_err(|e| CallError::new("internal", e.to_string()))
+        Ok(reply)
     }
 }
 
@@ -282,6 +363,7 @@ impl Plugin for TrajectoryPlugin {
     ) -> Result<Vec<u8>, CallError> {
         match command {
             "plan" => self.plan(payload, ctx),
+            "execute" => self.execute(payload, ctx),
             // World changes, the host's two-phase world commands and `stop`.
             _ => self
                 .session

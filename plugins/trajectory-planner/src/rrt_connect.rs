@@ -46,18 +46,7 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-/// Is a configuration free (no collision, within limits)?
-pub trait Validity {
-    /// True when `q` may be occupied.
-    fn is_valid(&mut self, q: &[f64]) -> bool;
-}
-
-/// How many equal steps a straight segment needs so that checking the step ends
-/// cannot miss an obstacle (see [`crate::resolution`]).
-pub trait SegmentSteps {
-    /// Number of steps (≥ 1) from `a` to `b`.
-    fn steps(&self, a: &[f64], b: &[f64]) -> usize;
-}
+pub use tsukami_planner_kit::motion_check::path::{lerp_into, SegmentSteps, Validity};
 
 /// A query: bounds of the space, start and goal.
 #[derive(Debug, Clone, Copy)]
@@ -173,13 +162,6 @@ pub fn coarse_to_fine(n: usize) -> impl Iterator<Item = usize> {
     std::iter::once(n)
         .filter(|&n| n > 0)
         .chain(strides.flat_map(move |s| (s..n).step_by(2 * s)))
-}
-
-/// `out = a + t (b − a)`.
-pub fn lerp_into(a: &[f64], b: &[f64], t: f64, out: &mut [f64]) {
-    for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
-        *o = x + t * (y - x);
-    }
 }
 
 fn distance(a: &[f64], b: &[f64]) -> f64 {

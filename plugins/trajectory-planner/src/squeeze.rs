@@ -3,7 +3,7 @@
 //! What: [`targets`] checks the request's `grasp.squeeze` against the hand (each
 //! entry an independent hand joint, named once, finite numbers, its `target`
 //! within the joint's limits); [`apply`] gives the trajectory's last `close`
-//! point and every `lift` point a `command`: the point's positions with each
+//! point and every `lift` (and `retreat`) point a `command`: the point's positions with each
 //! squeezed joint at its target (a mimic joint of the trajectory at its leader's
 //! target through the URDF's multiplier and offset, clamped into its limits).
 //!
@@ -148,7 +148,7 @@ pub fn apply_overrides(trajectory: &mut JointTrajectory, overrides: &[(usize, f6
     }
     let last_close = trajectory.points.iter().rposition(|p| p.phase == "close");
     for (k, p) in trajectory.points.iter_mut().enumerate() {
-        if Some(k) != last_close && p.phase != "lift" {
+        if Some(k) != last_close && p.phase != "lift" && p.phase != "retreat" {
             continue;
         }
         p.command.clone_from(&p.positions);

@@ -1,31 +1,40 @@
-//! Time scaling of a piecewise-linear joint path within velocity and acceleration
-//! limits.
+//! Time scaling of a joint path within velocity and acceleration limits,
+//! without stopping between its ends.
 //!
-//! What: [`time_path`] gives every segment of a joint-space polyline a trapezoidal
-//! (or triangular) velocity profile that starts and ends at rest, the fastest one
-//! that keeps every joint within its velocity limit and an acceleration limit, and
-//! samples it into timed points with positions and velocities.
+//! What: [`time_path`] rounds the corners of a joint-space polyline within a
+//! deviation ([`crate::blend`]), finds the fastest rest-to-rest speed along it
+//! that keeps every joint within its velocity limit and an acceleration limit
+//! ([`crate::topp`], TOPP-RA), and samples it into timed points with positions
+//! and velocities.
 //!
 //! Why: the controller plays a trajectory back by interpolating between points;
 //! points sampled from a profile that respects the limits give a playback that
 //! respects them too (between two samples a joint moves at the mean of its
-//! profile's velocity, which is within the limit).
+//! profile's velocity, which is within the limit). Rounded corners let the
+//! motion flow through the waypoints instead of stopping at each.
 //!
-//! How: along a segment `q(s) = a + s (b − a)`, `s ∈ [0, 1]`; joint `j` moves at
-//! `|Δ_j| ṡ` and accelerates at `|Δ_j| s̈`, so the fastest admissible profile has
-//! `ṡ ≤ p = min_j v_j / |Δ_j|` and `|s̈| ≤ α = min_j a_j / |Δ_j|`: a trapezoid of
-//! duration `1/p + p/α` when `p²/α ≤ 1`, otherwise a triangle of duration `2/√α`.
-//! Stopping at every waypoint is slower than blending, but exact and simple;
-//! shortcutting leaves few waypoints.
+//! How: the samples are at most `sample_dt` apart and include every point where
+//! one piece of the rounded path meets the next, so the polyline the
+//! controller follows is the rounded path's inscribed one; a caller that
+//! checks collisions checks that polyline ([`crate::motion`] does, and rounds
+//! less, down to stopping at the waypoints, when it collides). With deviation 0
+//! every corner is a stop and the motion between two waypoints is the fastest
+//! rest-to-rest one: a trapezoid (or triangle) of the path parameter.
 //!
 //! ```
 //! use tsukami_trajectory_planner::timing::{time_path, Limits};
 //! let limits = Limits { velocity: vec![1.0], acceleration: vec![2.0], sample_dt: 0.05 };
-//! let points = time_path(&[vec![0.0], vec![1.0]], &limits);
+//! let points = time_path(&[vec![0.0], vec![1.0]], &limits, 0.0);
 //! let end = points.last().unwrap();
-//! assert!((end.time - 1.5).abs() < 1e-12); // 1/p + p/α = 1 + 0.5
+//! assert!((end.time - 1.5).abs() < 0.01); // 1/v + v/a = 1 + 0.5
 //! assert_eq!(end.positions, vec![1.0]);
 //! ```
+
+use crate::blend::Blended;
+use crate::topp::parameterize;
+
+/// Largest step of the time scaling's grid along the path (joint units).
+pub const GRID_STEP: f64 = 0.002;
 
 /// Per-joint limits of a path's joints, and the sampling interval.
 #[derive(Debug, Clone, PartialEq)]
@@ -49,125 +58,143 @@ pub struct TimedPoint {
     pub velocities: Vec<f64>,
 }
 
-/// The fastest rest-to-rest profile of one segment: peak rate `p`, acceleration
-/// `alpha` of the path parameter, and its duration.
-#[derive(Debug, Clone, Copy)]
-struct Profile {
-    p: f64,
-    alpha: f64,
-    t_acc: f64,
-    duration: f64,
+/// Samples the timed path: the first point at time 0, then samples at most
+/// `sample_dt` apart (and at every piece break of the rounded path), ending at
+/// rest at the last waypoint. Corners are rounded within `deviation` (0: none,
+/// every waypoint a stop). A path without motion gives its first point only.
+pub fn time_path(path: &[Vec<f64>], limits: &Limits, deviation: f64) -> Vec<TimedPoint> {
+    time_path_with(path, limits, &vec![deviation; path.len()])
 }
 
-impl Profile {
-    fn new(a: &[f64], b: &[f64], limits: &Limits) -> Option<Profile> {
-        let mut p = f64::INFINITY;
-        let mut alpha = f64::INFINITY;
-        for j in 0..a.len() {
-            let d = (b[j] - a[j]).abs();
-            if d > 0.0 {
-                p = p.min(limits.velocity[j] / d);
-                alpha = alpha.min(limits.acceleration[j] / d);
-            }
-        }
-        if !p.is_finite() {
-            return None; // no motion
-        }
-        if p * p / alpha <= 1.0 {
-            let t_acc = p / alpha;
-            Some(Profile {
-                p,
-                alpha,
-                t_acc,
-                duration: 1.0 / p + t_acc,
-            })
-        } else {
-            let t_acc = (1.0 / alpha).sqrt();
-            Some(Profile {
-                p: alpha * t_acc,
-                alpha,
-                t_acc,
-                duration: 2.0 * t_acc,
-            })
-        }
-    }
-
-    /// Path parameter and its rate at time `t` into the segment.
-    fn at(&self, t: f64) -> (f64, f64) {
-        let t = t.clamp(0.0, self.duration);
-        let cruise_end = self.duration - self.t_acc;
-        if t < self.t_acc {
-            (0.5 * self.alpha * t * t, self.alpha * t)
-        } else if t <= cruise_end {
-            (
-                0.5 * self.alpha * self.t_acc * self.t_acc + self.p * (t - self.t_acc),
-                self.p,
-            )
-        } else {
-            let r = self.duration - t;
-            (1.0 - 0.5 * self.alpha * r * r, self.alpha * r)
-        }
-    }
-}
-
-/// Samples the timed path: the first point at time 0, then for each segment its
-/// profile's knots and samples at most `sample_dt` apart, ending at rest at the
-/// last waypoint. Segments without motion are skipped.
-pub fn time_path(path: &[Vec<f64>], limits: &Limits) -> Vec<TimedPoint> {
+/// [`time_path`] with a deviation per waypoint (`deviations[i]` rounds the
+/// corner at `path[i]`).
+pub fn time_path_with(path: &[Vec<f64>], limits: &Limits, deviations: &[f64]) -> Vec<TimedPoint> {
     let Some(first) = path.first() else {
         return vec![];
     };
-    let zero = vec![0.0; first.len()];
-    let mut out = vec![TimedPoint {
+    let start = TimedPoint {
         time: 0.0,
         positions: first.clone(),
-        velocities: zero.clone(),
-    }];
-    let mut t0 = 0.0;
-    for w in path.windows(2) {
-        let (a, b) = (&w[0], &w[1]);
-        let Some(profile) = Profile::new(a, b, limits) else {
-            continue;
-        };
-        let mut times = sample_times(&profile, limits.sample_dt);
-        times.remove(0);
-        for t in times {
-            let (s, rate) = profile.at(t);
-            let positions = a.iter().zip(b).map(|(x, y)| x + s * (y - x)).collect();
-            let velocities = a.iter().zip(b).map(|(x, y)| rate * (y - x)).collect();
-            out.push(TimedPoint {
-                time: t0 + t,
-                positions,
-                velocities,
-            });
+        velocities: vec![0.0; first.len()],
+    };
+    let blended = Blended::with_deviations(path, deviations);
+    let Some(mut profile) =
+        parameterize(&blended, &limits.velocity, &limits.acceleration, GRID_STEP)
+    else {
+        return vec![start];
+    };
+    // Sampled a little finer than `sample_dt`, so that slowing down by up to
+    // `STRETCH` keeps the samples `sample_dt` apart.
+    let dt = limits.sample_dt / STRETCH;
+    let mut out = sample(&blended, &profile, dt, start.clone(), path);
+    for _ in 0..3 {
+        let k = overshoot(&out, limits);
+        if k <= 1.0 {
+            break;
         }
-        let last = out.last_mut().expect("a segment adds points");
-        last.positions = b.clone();
-        last.velocities = zero.clone();
-        t0 += profile.duration;
+        if k <= STRETCH {
+            for p in &mut out {
+                p.time *= k;
+                p.velocities.iter_mut().for_each(|v| *v /= k);
+            }
+            break;
+        }
+        profile.stretch(k);
+        out = sample(&blended, &profile, dt, start.clone(), path);
     }
     out
 }
 
-/// Knots of the profile and uniform samples between them, at most `dt` apart.
-fn sample_times(profile: &Profile, dt: f64) -> Vec<f64> {
-    let knots = [
-        0.0,
-        profile.t_acc,
-        profile.duration - profile.t_acc,
-        profile.duration,
-    ];
-    let mut times = vec![0.0];
-    for w in knots.windows(2) {
-        let span = w[1] - w[0];
-        if span <= 1e-12 {
+/// The most the samples are slowed down in place ([`overshoot`]).
+const STRETCH: f64 = 1.1;
+
+/// The profile's samples: `start`, then at most `dt` apart and at every
+/// piece break and stop, then the last waypoint at rest.
+fn sample(
+    blended: &Blended,
+    profile: &crate::topp::Profile,
+    dt: f64,
+    start: TimedPoint,
+    path: &[Vec<f64>],
+) -> Vec<TimedPoint> {
+    let total = profile.duration();
+    let mut times: Vec<f64> = blended
+        .breaks()
+        .iter()
+        .chain(blended.stops())
+        .filter_map(|b| profile.s.iter().position(|s| (s - b).abs() < 1e-9))
+        .map(|i| profile.t[i])
+        .collect();
+    let n = (total / dt.max(1e-4)).ceil().max(1.0) as usize;
+    times.extend((1..n).map(|k| total * k as f64 / n as f64));
+    times.sort_by(f64::total_cmp);
+    times.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
+    let zero = vec![0.0; start.positions.len()];
+    let mut out = vec![start];
+    for t in times.into_iter().filter(|&t| t > 1e-9 && t < total - 1e-9) {
+        let (s, rate) = profile.at(t);
+        let (q, dq, _) = blended.at(s);
+        out.push(TimedPoint {
+            time: t,
+            positions: q,
+            velocities: dq.iter().map(|d| d * rate).collect(),
+        });
+    }
+    out.push(TimedPoint {
+        time: total,
+        positions: path.last().expect("not empty").clone(),
+        velocities: zero,
+    });
+    out
+}
+
+/// The least `k ≥ 1` such that `points`, slowed down by `k` (times × k,
+/// velocities ÷ k), keep every joint within its velocity limit all along the
+/// cubic Hermite curve the controller plays between two points (positions
+/// and velocities at both ends) and its mean velocity change within its
+/// acceleration limit. The grid's limits hold at its points; between them,
+/// on a tight arc, a joint may exceed them by a few per cent.
+fn overshoot(points: &[TimedPoint], limits: &Limits) -> f64 {
+    let mut k: f64 = 1.0;
+    for w in points.windows(2) {
+        let h = w[1].time - w[0].time;
+        if h <= 0.0 {
             continue;
         }
-        let n = (span / dt.max(1e-4)).ceil().max(1.0) as usize;
-        times.extend((1..=n).map(|i| w[0] + span * i as f64 / n as f64));
+        for j in 0..w[0].positions.len() {
+            let (q0, q1) = (w[0].positions[j], w[1].positions[j]);
+            let (v0, v1) = (w[0].velocities[j], w[1].velocities[j]);
+            let v = hermite_max_speed(q0, q1, v0, v1, h);
+            let a = (v1 - v0).abs() / h;
+            k = k
+                .max(v / limits.velocity[j] * SLACK)
+                .max((a / limits.acceleration[j] * SLACK).sqrt());
+        }
     }
-    times
+    k
 }
+
+/// The largest `|dq/dt|` of the cubic Hermite segment from `(q0, v0)` to
+/// `(q1, v1)` over `h` seconds (the controller's interpolation between two
+/// trajectory points). Scaling time by `k` scales it by `1/k`.
+fn hermite_max_speed(q0: f64, q1: f64, v0: f64, v1: f64, h: f64) -> f64 {
+    // dq/ds = a s² + b s + c for s ∈ [0, 1].
+    let a = 6.0 * q0 + 3.0 * h * v0 - 6.0 * q1 + 3.0 * h * v1;
+    let b = -6.0 * q0 - 4.0 * h * v0 + 6.0 * q1 - 2.0 * h * v1;
+    let c = h * v0;
+    let rate = |s: f64| ((a * s + b) * s + c).abs() / h;
+    let mut best = rate(0.0).max(rate(1.0));
+    if a != 0.0 {
+        let vertex = -b / (2.0 * a);
+        if (0.0..=1.0).contains(&vertex) {
+            best = best.max(rate(vertex));
+        }
+    }
+    best
+}
+
+/// Room left below every limit by [`overshoot`] (a fraction).
+const SLACK: f64 = 1.0 + 1e-3;
 
 #[cfg(test)]
 mod tests {
@@ -190,7 +217,7 @@ mod tests {
             vec![-0.4, 0.9],
         ];
         let lim = limits();
-        let pts = time_path(&path, &lim);
+        let pts = time_path(&path, &lim, 0.0);
         for w in pts.windows(2) {
             let dt = w[1].time - w[0].time;
             assert!(dt > 0.0 && dt <= lim.sample_dt + 1e-12);
@@ -202,21 +229,51 @@ mod tests {
                 assert!(a <= lim.acceleration[j] + 1e-6, "joint {j}: accel {a}");
             }
         }
-        // Every waypoint is reached at rest.
+        // Without rounding, every waypoint is reached at rest.
+        let near = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9);
         for q in &path {
             assert!(pts
                 .iter()
-                .any(|p| &p.positions == q && p.velocities == vec![0.0, 0.0]));
+                .any(|p| near(&p.positions, q) && near(&p.velocities, &[0.0, 0.0])));
+        }
+    }
+
+    #[test]
+    fn a_rounded_path_never_stops_between_its_ends_and_keeps_the_limits() {
+        let path = vec![
+            vec![0.0, 0.0],
+            vec![1.2, -0.3],
+            vec![1.25, 0.9],
+            vec![-0.4, 0.9],
+        ];
+        let lim = limits();
+        let sharp = time_path(&path, &lim, 0.0);
+        let pts = time_path(&path, &lim, 0.1);
+        let inner = &pts[1..pts.len() - 1];
+        assert!(inner
+            .iter()
+            .all(|p| p.velocities.iter().any(|v| v.abs() > 1e-6)));
+        assert!(pts.last().unwrap().time < sharp.last().unwrap().time);
+        assert_eq!(pts.last().unwrap().positions, path[3]);
+        for w in pts.windows(2) {
+            let dt = w[1].time - w[0].time;
+            assert!(dt > 0.0 && dt <= lim.sample_dt + 1e-12);
+            for j in 0..2 {
+                let v = (w[1].positions[j] - w[0].positions[j]).abs() / dt;
+                assert!(v <= lim.velocity[j] * 1.01, "joint {j}: {v}");
+                let a = (w[1].velocities[j] - w[0].velocities[j]).abs() / dt;
+                assert!(a <= lim.acceleration[j] * 1.05, "joint {j}: accel {a}");
+            }
         }
     }
 
     #[test]
     fn short_moves_are_triangles_and_no_motion_adds_nothing() {
         let lim = limits();
-        let pts = time_path(&[vec![0.0, 0.0], vec![0.1, 0.0]], &lim);
+        let pts = time_path(&[vec![0.0, 0.0], vec![0.1, 0.0]], &lim, 0.0);
         // Triangle: 2·sqrt(Δ/a) = 2·sqrt(0.05).
-        assert!((pts.last().unwrap().time - 2.0 * 0.05f64.sqrt()).abs() < 1e-12);
-        let still = time_path(&[vec![0.3, 0.3], vec![0.3, 0.3]], &lim);
+        assert!((pts.last().unwrap().time - 2.0 * 0.05f64.sqrt()).abs() < 2e-3);
+        let still = time_path(&[vec![0.3, 0.3], vec![0.3, 0.3]], &lim, 0.0);
         assert_eq!(still.len(), 1);
     }
 }

@@ -13,7 +13,9 @@
 //!    `closing`), then obstacles and self-collision again;
 //! 6. **holding** — accepted when the kit's hold test passes (kit
 //!    `verify::holds`: exact force closure and the request's disturbances
-//!    within the joints' torques, `PlanOptions::hold`).
+//!    within the joints' torques, `PlanOptions::hold`);
+//! 7. **motion** — the approach, closing and lift the grasp implies are free
+//!    (kit `Run::motion_phases`, the trajectory planner's own checks).
 //!
 //! Each failed step names its reason (`run.reject`), which the kit reports.
 //! `palm_criterion`, `delta_f` and `max_candidates` belong to the paper's
@@ -140,7 +142,13 @@ impl GraspPlanner for Antipodal {
                 match s.attempt(&mut ik) {
                     Ok((q, contacts, length, approach)) => {
                         let face = w.object.face_toward(&approach);
-                        return Ok(Grasp::on_stage(gt, face, stage, q, contacts, length));
+                        let g = Grasp::on_stage(gt.clone(), face, stage, q, contacts, length);
+                        // Step 7: the approach, closing and lift it implies
+                        // are free (the kit's, the trajectory planner's checks).
+                        match run.motion_phases(w, &g) {
+                            Ok(()) => return Ok(g),
+                            Err(_) => run.reject("approach, closing or lift blocked"),
+                        }
                     }
                     Err(why) => run.reject(why),
                 }

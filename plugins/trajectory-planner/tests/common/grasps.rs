@@ -22,11 +22,13 @@ pub fn models() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
 }
 
-fn grasp_planner_file() -> PathBuf {
+/// The grasp planner's plugin file cargo built beside the test, bench or
+/// example binary.
+pub fn grasp_planner_file() -> PathBuf {
     let exe = std::env::current_exe().expect("current_exe");
     let deps = exe.parent().expect("the binary's folder");
     let file = library_file_name("tsukami_grasp_planner");
-    [deps.to_owned(), deps.join("..")]
+    [deps.to_owned(), deps.join(".."), deps.join("../deps")]
         .into_iter()
         .map(|d| d.join(&file))
         .find(|p| p.is_file())

@@ -22,7 +22,7 @@
 //!
 //! ```
 //! use tsukami_body::model::RobotModel;
-//! use tsukami_trajectory_planner::resolution::SweepBound;
+//! use tsukami_planner_kit::motion_check::resolution::SweepBound;
 //! let urdf = r#"<robot name="r">
 //!   <link name="base"/>
 //!   <link name="arm"><collision><origin xyz="0.5 0 0"/><geometry><sphere radius="0.1"/></geometry></collision></link>

@@ -11,9 +11,9 @@
 //!
 //! How: each pose is solved by the body crate's damped least-squares IK from the
 //! previous configuration, one attempt, pulled toward the previous
-//! configuration, so consecutive solutions stay on one branch; a solution that
-//! fails the tolerance or jumps (any joint more than `MAX_JUMP`) ends the line
-//! with `None`. Straight joint-space segments join the poses; the palm deviates
+//! configuration, so consecutive solutions stay on one branch; a step whose
+//! solution fails the tolerance or jumps (any joint more than `MAX_JUMP`) is
+//! halved, up to [`SUBDIVISIONS`] times, before the line ends with `None`. Straight joint-space segments join the poses; the palm deviates
 //! from the line between them by far less than the step.
 
 use nalgebra::{Isometry3, Translation3, Vector3};
@@ -62,19 +62,43 @@ pub fn palm_line(
     let n = (length / step).ceil().max(1.0) as usize;
     let mut q = from.to_vec();
     let mut out = Vec::with_capacity(n);
+    let pose = |s: f64| Translation3::from(direction * s) * start_pose;
     for i in 1..=n {
-        let s = length * i as f64 / n as f64;
-        let target = Translation3::from(direction * s) * start_pose;
-        let sol = solver.solve(&target, true, &q, Some(&q));
-        let jump = joints
-            .iter()
-            .map(|&j| (sol.q[j] - q[j]).abs())
-            .fold(0.0, f64::max);
-        if !sol.ok || jump > MAX_JUMP {
-            return None;
-        }
-        q = sol.q;
+        let (s0, s1) = (
+            length * (i - 1) as f64 / n as f64,
+            length * i as f64 / n as f64,
+        );
+        q = step_to(&mut solver, joints, &q, (s0, s1), &pose, SUBDIVISIONS)?;
         out.push(q.clone());
     }
     Some(out)
+}
+
+/// How many times a step the IK cannot take at once is halved.
+pub const SUBDIVISIONS: usize = 3;
+
+/// The configuration at line position `s1` from `q` at `s0`: one IK solve,
+/// or, when it fails or jumps, the two halves in turn (`depth` more times).
+fn step_to(
+    solver: &mut IkSolver<'_>,
+    joints: &[JointId],
+    q: &[f64],
+    (s0, s1): (f64, f64),
+    pose: &dyn Fn(f64) -> Isometry3<f64>,
+    depth: usize,
+) -> Option<Vec<f64>> {
+    let sol = solver.solve(&pose(s1), true, q, Some(q));
+    let jump = joints
+        .iter()
+        .map(|&j| (sol.q[j] - q[j]).abs())
+        .fold(0.0, f64::max);
+    if sol.ok && jump <= MAX_JUMP {
+        return Some(sol.q);
+    }
+    if depth == 0 {
+        return None;
+    }
+    let mid = 0.5 * (s0 + s1);
+    let half = step_to(solver, joints, q, (s0, mid), pose, depth - 1)?;
+    step_to(solver, joints, &half, (mid, s1), pose, depth - 1)
 }

@@ -5,7 +5,7 @@
 //! joints free of self-collision and of collision with every obstacle?) and its
 //! [`Resolution`] answers [`SegmentSteps`] (how many checks a straight segment needs so that no link
 //! point moves more than `max_travel` between two of them, see
-//! [`crate::resolution`]).
+//! [`super::resolution`]).
 //!
 //! Why: RRT-Connect and shortcutting work on the planned joints only (arm; arm +
 //! waist; arm + waist + squat); the rest of the robot stays where the start put it,
@@ -35,9 +35,9 @@ use tsukami_body::collision::{CollisionObject, Placement, RobotCollision};
 use tsukami_body::kinematics::FkState;
 use tsukami_body::model::{JointId, LinkId, RobotModel};
 
-use crate::bodies::Bodies;
-use crate::resolution::SweepBound;
-use crate::rrt_connect::{SegmentSteps, Validity};
+use super::bodies::Bodies;
+use super::path::{SegmentSteps, Validity};
+use super::resolution::SweepBound;
 
 /// Default largest travel of any link point between two checks of a segment:
 /// half of the thinnest obstacle the planner promises not to skip (1 cm).
