@@ -211,7 +211,10 @@ impl<'w> Fine<'w> {
             rules.push((hand_links, CLEARANCE_HAND - SLACK));
         }
         for (links, margin) in rules {
-            if let Some(h) = self.collision.first_collision(&self.fk, &links, &obstacles, margin) {
+            if let Some(h) = self
+                .collision
+                .first_collision(&self.fk, &links, &obstacles, margin)
+            {
                 return Some(format!(
                     "{} within {:.1} mm of {} ({phase})",
                     name(h.link),
@@ -732,7 +735,12 @@ fn placements_with_walls_and_shelves_move_clear_of_everything() {
     let c = &bus.client;
     let robot = json!({"robot": "tsukami_humanoid"});
     let send = |command: &str, v: &serde_json::Value| {
-        c.command(ROLE_GRASP_PLANNER, command, v.to_string().as_bytes(), TIMEOUT)
+        c.command(
+            ROLE_GRASP_PLANNER,
+            command,
+            v.to_string().as_bytes(),
+            TIMEOUT,
+        )
     };
     send(planner::SET_ROBOT, &robot).expect("set_robot");
     let all = objects::objects();
@@ -748,10 +756,15 @@ fn placements_with_walls_and_shelves_move_clear_of_everything() {
                 if wall {
                     let [x, y] = p.xy;
                     let far = [x + 0.13, y, p.top / 2.0 + 0.3];
-                    let w = serde_json::to_value(board("wall", far, [0.02, 0.6, p.top + 0.6])).unwrap();
+                    let w =
+                        serde_json::to_value(board("wall", far, [0.02, 0.6, p.top + 0.6])).unwrap();
                     env["obstacles"].as_array_mut().unwrap().push(w);
                 }
-                let case = format!("{name} on {}{}", p.name, if wall { " by a wall" } else { "" });
+                let case = format!(
+                    "{name} on {}{}",
+                    p.name,
+                    if wall { " by a wall" } else { "" }
+                );
                 send(planner::SET_OBJECT, &object).expect("set_object");
                 send(planner::SET_ENV, &env).expect("set_env");
                 let Ok(bytes) = send(planner::PLAN, &json!({"seed": 1})) else {
@@ -773,10 +786,18 @@ fn placements_with_walls_and_shelves_move_clear_of_everything() {
                         ends_at_the_grasp(&world, t, &grasp);
                         let checks = check_collisions(&world, t);
                         moved += 1;
-                        tried.push(format!("{case}: moved, {:.2} s, {checks} re-checks", t.points.last().unwrap().time));
+                        tried.push(format!(
+                            "{case}: moved, {:.2} s, {checks} re-checks",
+                            t.points.last().unwrap().time
+                        ));
                     }
                     Err(RequestError::Reply(e)) => {
-                        assert_eq!(e.error.code, ErrorCode::Infeasible, "{case}: {}", e.error.message);
+                        assert_eq!(
+                            e.error.code,
+                            ErrorCode::Infeasible,
+                            "{case}: {}",
+                            e.error.message
+                        );
                         let reason = e.error.details.as_ref().unwrap()["reason"].clone();
                         // The grasp planner checked these phases: never blocked here.
                         for blocked in ["approach_blocked", "close_blocked", "lift_blocked"] {

@@ -96,9 +96,9 @@ fn default_servo_saturation() -> f64 {
     0.2
 }
 
-/// Joint acceleration limits (rad/s², m/s² for prismatic joints), which a
-/// URDF cannot state (MoveIt keeps them in `joint_limits.yaml`). Motions are
-/// timed within them.
+/// Joint acceleration (or jerk) limits (rad/s², m/s² for prismatic joints;
+/// s³ for jerk), which a URDF cannot state (MoveIt keeps them in
+/// `joint_limits.yaml`). Motions are timed within them.
 #[derive(Debug, Clone, PartialEq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AccelerationSpec {
@@ -152,6 +152,10 @@ pub struct Description {
     /// Joint acceleration limits (default: none stated).
     #[serde(default)]
     pub acceleration: AccelerationSpec,
+    /// Joint jerk limits (rad/s³, m/s³; same keys as `acceleration`; default:
+    /// none, the motion's jerk is not limited).
+    #[serde(default)]
+    pub jerk: AccelerationSpec,
     /// Safety distances of this robot's motions (default: none stated).
     #[serde(default)]
     pub clearance: ClearanceSpec,
@@ -197,22 +201,28 @@ impl Description {
                 return Err(bad(key("servo_saturation"), "must be in (0, 3]"));
             }
         }
-        let a = &self.acceleration;
-        let named = a
-            .joints
-            .iter()
-            .map(|(j, v)| (format!("acceleration.joints.{j}"), *v));
-        let groups = [
-            ("acceleration.default", a.default),
-            ("acceleration.hand", a.hand),
-        ]
-        .into_iter()
-        .filter_map(|(k, v)| v.map(|v| (k.to_owned(), v)));
-        if let Some((k, _)) = groups
-            .chain(named)
-            .find(|(_, v)| !(v.is_finite() && *v > 0.0 && *v <= 1e4))
-        {
-            return Err(bad(k, "must be in (0, 10000] rad/s² (or m/s²)"));
+        for (table, spec, most, unit) in [
+            (
+                "acceleration",
+                &self.acceleration,
+                1e4,
+                "10000] rad/s² (or m/s²)",
+            ),
+            ("jerk", &self.jerk, 1e6, "1000000] rad/s³ (or m/s³)"),
+        ] {
+            let named = spec
+                .joints
+                .iter()
+                .map(|(j, v)| (format!("{table}.joints.{j}"), *v));
+            let groups = [("default", spec.default), ("hand", spec.hand)]
+                .into_iter()
+                .filter_map(|(k, v)| v.map(|v| (format!("{table}.{k}"), v)));
+            if let Some((k, _)) = groups
+                .chain(named)
+                .find(|(_, v)| !(v.is_finite() && *v > 0.0 && *v <= most))
+            {
+                return Err(bad(k, &format!("must be in (0, {unit}")));
+            }
         }
         let c = &self.clearance;
         for (k, v) in [("clearance.body", c.body), ("clearance.hand", c.hand)] {
@@ -263,6 +273,7 @@ mod tests {
                 "acceleration.joints.a",
             ),
             ("[clearance]\nbody = 0.5\n", "clearance.body"),
+            ("[jerk]\ndefault = 0.0\n", "jerk.default"),
         ] {
             let e = Description::parse(&format!("{ok}\n{extra}"), "d.toml").unwrap_err();
             assert!(e.to_string().contains(key), "{e}");

@@ -106,6 +106,9 @@ pub struct Robot {
     /// Per joint (by id), its acceleration limit from the description's
     /// `[acceleration]` table, if it states one.
     pub acceleration: Vec<Option<f64>>,
+    /// Per joint (by id), its jerk limit from the description's `[jerk]`
+    /// table, if it states one.
+    pub jerk: Vec<Option<f64>>,
     /// The description's safety distances, if it states them.
     pub clearance: crate::description::ClearanceSpec,
 }
@@ -120,12 +123,14 @@ fn below(model: &RobotModel, root: LinkId) -> Vec<LinkId> {
     out
 }
 
-/// The description's acceleration limits per joint id: a named joint's own,
-/// else the hand's for a joint below a palm, else the default.
-fn accelerations(
+/// The description's `table` limits (acceleration, jerk) per joint id: a
+/// named joint's own, else the hand's for a joint below a palm, else the
+/// default.
+fn per_joint(
     model: &RobotModel,
     hands: &[Hand],
     spec: &crate::description::AccelerationSpec,
+    table: &str,
 ) -> Result<Vec<Option<f64>>, KitError> {
     let mut out: Vec<Option<f64>> = (0..model.joints.len())
         .map(|j| {
@@ -140,7 +145,7 @@ fn accelerations(
         })
         .collect();
     for (name, &v) in &spec.joints {
-        let key = format!("acceleration.joints.{name}");
+        let key = format!("{table}.joints.{name}");
         let j = ids(model, std::slice::from_ref(name), &key)?[0];
         out[j] = Some(v);
     }
@@ -362,7 +367,8 @@ impl Robot {
         }
         let waist = ids(&model, &description.waist, "waist")?;
         let whole_body = ids(&model, &description.whole_body, "whole_body")?;
-        let acceleration = accelerations(&model, &hands, &description.acceleration)?;
+        let acceleration = per_joint(&model, &hands, &description.acceleration, "acceleration")?;
+        let jerk = per_joint(&model, &hands, &description.jerk, "jerk")?;
         Ok(Robot {
             model,
             hands,
@@ -370,6 +376,7 @@ impl Robot {
             whole_body,
             description_name: file.name().to_owned(),
             acceleration,
+            jerk,
             clearance: description.clearance,
         })
     }

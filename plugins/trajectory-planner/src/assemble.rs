@@ -10,7 +10,7 @@
 //! ```
 //! use tsukami_trajectory_planner::assemble::{assemble, Phase};
 //! use tsukami_trajectory_planner::timing::{time_path, Limits};
-//! let limits = Limits { velocity: vec![1.0], acceleration: vec![2.0], sample_dt: 0.1 };
+//! let limits = Limits { velocity: vec![1.0], acceleration: vec![2.0], sample_dt: 0.1, jerk: vec![] };
 //! let phases = [
 //!     Phase { name: "reach", points: time_path(&[vec![0.0], vec![1.0]], &limits, 0.0) },
 //!     Phase { name: "lift", points: time_path(&[vec![1.0], vec![1.2]], &limits, 0.0) },

@@ -368,9 +368,9 @@ fn timed(
 }
 
 /// The time scaling's limits of `joints`: each joint's URDF velocity (the
-/// config's `default_velocity` when it states none) and its acceleration —
+/// config's `default_velocity` when it states none), its acceleration —
 /// `acceleration` (a request's) when given, else the robot description's,
-/// else the config's.
+/// else the config's — and its jerk when the description states one.
 pub fn joint_limits(
     robot: &tsukami_planner_kit::Robot,
     joints: &[JointId],
@@ -396,10 +396,30 @@ pub fn joint_limits(
                 .unwrap_or(cfg.acceleration)
         })
         .collect();
+    // Jerk: the description's, for every joint or none (a joint it leaves
+    // out is not limited).
+    let jerk = match joints
+        .iter()
+        .any(|&j| robot.jerk.get(j).copied().flatten().is_some())
+    {
+        true => joints
+            .iter()
+            .map(|&j| {
+                robot
+                    .jerk
+                    .get(j)
+                    .copied()
+                    .flatten()
+                    .unwrap_or(f64::INFINITY)
+            })
+            .collect(),
+        false => Vec::new(),
+    };
     timing::Limits {
         velocity,
         acceleration,
         sample_dt: cfg.sample_dt,
+        jerk,
     }
 }
 

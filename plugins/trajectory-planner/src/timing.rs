@@ -23,7 +23,7 @@
 //!
 //! ```
 //! use tsukami_trajectory_planner::timing::{time_path, Limits};
-//! let limits = Limits { velocity: vec![1.0], acceleration: vec![2.0], sample_dt: 0.05 };
+//! let limits = Limits { velocity: vec![1.0], acceleration: vec![2.0], sample_dt: 0.05, jerk: vec![] };
 //! let points = time_path(&[vec![0.0], vec![1.0]], &limits, 0.0);
 //! let end = points.last().unwrap();
 //! assert!((end.time - 1.5).abs() < 0.01); // 1/v + v/a = 1 + 0.5
@@ -45,6 +45,8 @@ pub struct Limits {
     pub acceleration: Vec<f64>,
     /// Longest interval between two samples (s).
     pub sample_dt: f64,
+    /// Jerk limit per joint (rad/s³ or m/s³); empty: none.
+    pub jerk: Vec<f64>,
 }
 
 /// A sampled point of a timed path.
@@ -87,12 +89,14 @@ pub fn time_path_with(path: &[Vec<f64>], limits: &Limits, deviations: &[f64]) ->
     // `STRETCH` keeps the samples `sample_dt` apart.
     let dt = limits.sample_dt / STRETCH;
     let mut out = sample(&blended, &profile, dt, start.clone(), path);
-    for _ in 0..3 {
+    // Resampling after a stretch keeps the sample spacing, so a jerk measured
+    // across one sample falls only as 1/k²: a few rounds, then in place.
+    for round in 0..=RESAMPLES {
         let k = overshoot(&out, limits);
         if k <= 1.0 {
             break;
         }
-        if k <= STRETCH {
+        if k <= STRETCH || round == RESAMPLES {
             for p in &mut out {
                 p.time *= k;
                 p.velocities.iter_mut().for_each(|v| *v /= k);
@@ -104,6 +108,9 @@ pub fn time_path_with(path: &[Vec<f64>], limits: &Limits, deviations: &[f64]) ->
     }
     out
 }
+
+/// How many times a profile slowed down is sampled again ([`time_path_with`]).
+const RESAMPLES: usize = 6;
 
 /// The most the samples are slowed down in place ([`overshoot`]).
 const STRETCH: f64 = 1.1;
@@ -151,8 +158,9 @@ fn sample(
 /// The least `k ≥ 1` such that `points`, slowed down by `k` (times × k,
 /// velocities ÷ k), keep every joint within its velocity limit all along the
 /// cubic Hermite curve the controller plays between two points (positions
-/// and velocities at both ends) and its mean velocity change within its
-/// acceleration limit. The grid's limits hold at its points; between them,
+/// and velocities at both ends), its mean velocity change within its
+/// acceleration limit and, when it has one, that curve's jerk within its jerk
+/// limit. The grid's limits hold at its points; between them,
 /// on a tight arc, a joint may exceed them by a few per cent.
 fn overshoot(points: &[TimedPoint], limits: &Limits) -> f64 {
     let mut k: f64 = 1.0;
@@ -169,9 +177,20 @@ fn overshoot(points: &[TimedPoint], limits: &Limits) -> f64 {
             k = k
                 .max(v / limits.velocity[j] * SLACK)
                 .max((a / limits.acceleration[j] * SLACK).sqrt());
+            if let Some(&jmax) = limits.jerk.get(j) {
+                k = k.max((hermite_jerk(q0, q1, v0, v1, h) / jmax * SLACK).cbrt());
+            }
         }
     }
     k
+}
+
+/// The jerk `|d³q/dt³|` of the cubic Hermite segment from `(q0, v0)` to
+/// `(q1, v1)` over `h` seconds, constant along it: `|2 a| / h³` with `a` the
+/// `s²` coefficient of `dq/ds`. Scaling time by `k` scales it by `1/k³`.
+fn hermite_jerk(q0: f64, q1: f64, v0: f64, v1: f64, h: f64) -> f64 {
+    let a = 6.0 * q0 + 3.0 * h * v0 - 6.0 * q1 + 3.0 * h * v1;
+    (2.0 * a).abs() / (h * h * h)
 }
 
 /// The largest `|dq/dt|` of the cubic Hermite segment from `(q0, v0)` to
@@ -205,6 +224,7 @@ mod tests {
             velocity: vec![1.0, 0.5],
             acceleration: vec![2.0, 2.0],
             sample_dt: 0.02,
+            jerk: vec![],
         }
     }
 
@@ -263,6 +283,32 @@ mod tests {
                 assert!(v <= lim.velocity[j] * 1.01, "joint {j}: {v}");
                 let a = (w[1].velocities[j] - w[0].velocities[j]).abs() / dt;
                 assert!(a <= lim.acceleration[j] * 1.05, "joint {j}: accel {a}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_jerk_limit_slows_the_motion_until_every_segment_keeps_it() {
+        let path = vec![vec![0.0, 0.0], vec![1.2, -0.3], vec![1.25, 0.9]];
+        let free = time_path(&path, &limits(), 0.1);
+        let lim = Limits {
+            jerk: vec![20.0, 20.0],
+            ..limits()
+        };
+        let pts = time_path(&path, &lim, 0.1);
+        assert!(pts.last().unwrap().time > free.last().unwrap().time);
+        for w in pts.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            let h = b.time - a.time;
+            for j in 0..2 {
+                let jerk = hermite_jerk(
+                    a.positions[j],
+                    b.positions[j],
+                    a.velocities[j],
+                    b.velocities[j],
+                    h,
+                );
+                assert!(jerk <= 20.0 * 1.0001, "joint {j}: {jerk}");
             }
         }
     }
