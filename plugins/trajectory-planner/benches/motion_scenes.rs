@@ -42,18 +42,7 @@ fn times(
     let mut out = Vec::new();
     let (mut ok, mut duration, mut checks) = (0, 0.0, 0);
     for seed in 0..SEEDS {
-        let query = MotionQuery {
-            grasp,
-            start: w.robot.model.rest_positions(),
-            lift_height: 0.05,
-            pregrasp_distance: 0.05,
-            retreat_distance: 0.0,
-            seed,
-            max_samples: 5000,
-            recheck: false,
-            clearance: tsukami_trajectory_planner::motion::Clearance::default(),
-            acceleration: None,
-        };
+        let query = MotionQuery::new(grasp, w.robot.model.rest_positions(), seed);
         let t = Instant::now();
         let r = plan_motion(
             &w,

@@ -26,7 +26,7 @@ use abi_stable::sabi_trait::TD_Opaque;
 use abi_stable::std_types::RArc;
 use objects::{objects, placements, set_env, set_object};
 use serde_json::{json, Value};
-use tsukami_msgs::motion::{MotionGrasp, DEFAULT_LIFT_HEIGHT, DEFAULT_PREGRASP_DISTANCE};
+use tsukami_msgs::motion::MotionGrasp;
 use tsukami_msgs::planner::{SetEnv, SetObject, SetRobot};
 use tsukami_planner_kit::validate::Limits;
 use tsukami_planner_kit::{PlannerConfig, Session};
@@ -44,18 +44,7 @@ fn motion(world: &Session<SharedWorld>, grasp: &MotionGrasp) -> Result<(), Strin
     let snapshot = world.snapshot();
     let w = snapshot.world().map_err(|e| e.to_string())?;
     let cfg = MotionConfig::default();
-    let query = MotionQuery {
-        grasp,
-        start: w.robot.model.rest_positions(),
-        lift_height: DEFAULT_LIFT_HEIGHT,
-        pregrasp_distance: DEFAULT_PREGRASP_DISTANCE,
-        retreat_distance: 0.0,
-        seed: 0,
-        max_samples: 5000,
-        recheck: false,
-        clearance: cfg.clearance,
-        acceleration: None,
-    };
+    let query = MotionQuery::new(grasp, w.robot.model.rest_positions(), 0);
     let out = plan_motion(
         &w,
         &query,

@@ -35,18 +35,7 @@ fn main() {
         let (world, grasp) = grasps::scene(scene, 0);
         let snapshot = world.snapshot();
         let w = snapshot.world().expect("a world");
-        let query = MotionQuery {
-            grasp: &grasp,
-            start: w.robot.model.rest_positions(),
-            lift_height: tsukami_msgs::motion::DEFAULT_LIFT_HEIGHT,
-            pregrasp_distance: tsukami_msgs::motion::DEFAULT_PREGRASP_DISTANCE,
-            retreat_distance: 0.0,
-            seed: 1,
-            max_samples: 5000,
-            recheck: false,
-            clearance: cfg.clearance,
-            acceleration: None,
-        };
+        let query = MotionQuery::new(&grasp, w.robot.model.rest_positions(), 1);
         let m = plan_motion(
             &w,
             &query,

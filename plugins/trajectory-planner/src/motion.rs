@@ -128,6 +128,26 @@ pub struct MotionQuery<'a> {
     pub clearance: Clearance,
 }
 
+impl<'a> MotionQuery<'a> {
+    /// The query of `grasp` from the full configuration `start` with the
+    /// request's defaults (5 cm pre-grasp and lift, no retreat, 5000 reach
+    /// samples, the default clearances, the robot's accelerations), `seed`.
+    pub fn new(grasp: &'a MotionGrasp, start: Vec<f64>, seed: u64) -> Self {
+        MotionQuery {
+            grasp,
+            start,
+            lift_height: tsukami_msgs::motion::DEFAULT_LIFT_HEIGHT,
+            pregrasp_distance: tsukami_msgs::motion::DEFAULT_PREGRASP_DISTANCE,
+            retreat_distance: 0.0,
+            seed,
+            max_samples: 5000,
+            acceleration: None,
+            recheck: false,
+            clearance: Clearance::default(),
+        }
+    }
+}
+
 /// A planned motion.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Motion {

@@ -189,18 +189,23 @@ fn overshoot(points: &[TimedPoint], limits: &Limits) -> f64 {
 /// `(q1, v1)` over `h` seconds, constant along it: `|2 a| / h³` with `a` the
 /// `s²` coefficient of `dq/ds`. Scaling time by `k` scales it by `1/k³`.
 fn hermite_jerk(q0: f64, q1: f64, v0: f64, v1: f64, h: f64) -> f64 {
-    let a = 6.0 * q0 + 3.0 * h * v0 - 6.0 * q1 + 3.0 * h * v1;
+    let (a, _, _) = hermite_derivative(q0, q1, v0, v1, h);
     (2.0 * a).abs() / (h * h * h)
+}
+
+/// `dq/ds = a s² + b s + c` (`s ∈ [0, 1]`) of the cubic Hermite segment from
+/// `(q0, v0)` to `(q1, v1)` over `h` seconds.
+fn hermite_derivative(q0: f64, q1: f64, v0: f64, v1: f64, h: f64) -> (f64, f64, f64) {
+    let a = 6.0 * q0 + 3.0 * h * v0 - 6.0 * q1 + 3.0 * h * v1;
+    let b = -6.0 * q0 - 4.0 * h * v0 + 6.0 * q1 - 2.0 * h * v1;
+    (a, b, h * v0)
 }
 
 /// The largest `|dq/dt|` of the cubic Hermite segment from `(q0, v0)` to
 /// `(q1, v1)` over `h` seconds (the controller's interpolation between two
 /// trajectory points). Scaling time by `k` scales it by `1/k`.
 fn hermite_max_speed(q0: f64, q1: f64, v0: f64, v1: f64, h: f64) -> f64 {
-    // dq/ds = a s² + b s + c for s ∈ [0, 1].
-    let a = 6.0 * q0 + 3.0 * h * v0 - 6.0 * q1 + 3.0 * h * v1;
-    let b = -6.0 * q0 - 4.0 * h * v0 + 6.0 * q1 - 2.0 * h * v1;
-    let c = h * v0;
+    let (a, b, c) = hermite_derivative(q0, q1, v0, v1, h);
     let rate = |s: f64| ((a * s + b) * s + c).abs() / h;
     let mut best = rate(0.0).max(rate(1.0));
     if a != 0.0 {

@@ -136,6 +136,23 @@ fn x_range(rows: &[Row], lo: f64, hi: f64) -> Option<(f64, f64)> {
     (lo <= hi + 1e-12).then_some((lo, hi.max(lo)))
 }
 
+/// The rows of a grid point and those that keep `x + d2 u` (the next state)
+/// inside the next point's controllable set `[lo1, hi1]`.
+fn into_next(rows: &[Row], d2: f64, (lo1, hi1): (f64, f64)) -> Vec<Row> {
+    let mut r = rows.to_vec();
+    r.push(Row {
+        ax: 1.0,
+        au: d2,
+        c: hi1,
+    });
+    r.push(Row {
+        ax: -1.0,
+        au: -d2,
+        c: -lo1,
+    });
+    r
+}
+
 /// The largest `u` every row allows at `x`, or `None`.
 fn u_max(rows: &[Row], x: f64) -> Option<f64> {
     let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
@@ -177,17 +194,7 @@ pub fn parameterize(path: &Blended, v: &[f64], a: &[f64], step: f64) -> Option<P
     for i in (0..n).rev() {
         let d2 = 2.0 * (s[i + 1] - s[i]);
         let (lo1, hi1) = k[i + 1];
-        let mut r = rows[i].clone();
-        r.push(Row {
-            ax: 1.0,
-            au: d2,
-            c: hi1,
-        });
-        r.push(Row {
-            ax: -1.0,
-            au: -d2,
-            c: -lo1,
-        });
+        let r = into_next(&rows[i], d2, (lo1, hi1));
         k[i] = x_range(&r, 0.0, xmax[i])?;
     }
     // Forward pass: the greedy step.
@@ -195,17 +202,7 @@ pub fn parameterize(path: &Blended, v: &[f64], a: &[f64], step: f64) -> Option<P
     for i in 0..n {
         let d2 = 2.0 * (s[i + 1] - s[i]);
         let (lo1, hi1) = k[i + 1];
-        let mut r = rows[i].clone();
-        r.push(Row {
-            ax: 1.0,
-            au: d2,
-            c: hi1,
-        });
-        r.push(Row {
-            ax: -1.0,
-            au: -d2,
-            c: -lo1,
-        });
+        let r = into_next(&rows[i], d2, (lo1, hi1));
         let u = u_max(&r, x[i]).unwrap_or((hi1 - x[i]) / d2);
         x[i + 1] = (x[i] + d2 * u).clamp(lo1.max(0.0), hi1);
     }

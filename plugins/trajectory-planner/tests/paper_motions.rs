@@ -13,18 +13,7 @@ fn motion(scene: &str, seed: u64) -> (Motion, MotionGrasp) {
     let (world, grasp) = common::grasps::scene(scene, 0);
     let snapshot = world.snapshot();
     let w = snapshot.world().unwrap();
-    let query = MotionQuery {
-        grasp: &grasp,
-        start: w.robot.model.rest_positions(),
-        lift_height: 0.05,
-        pregrasp_distance: 0.05,
-        retreat_distance: 0.0,
-        seed,
-        max_samples: 5000,
-        recheck: false,
-        clearance: tsukami_trajectory_planner::motion::Clearance::default(),
-        acceleration: None,
-    };
+    let query = MotionQuery::new(&grasp, w.robot.model.rest_positions(), seed);
     let cfg = MotionConfig::default();
     let m = plan_motion(
         &w,
@@ -158,18 +147,7 @@ fn progress_in_phase_order_and_stop_cancels() {
     let (world, grasp) = common::grasps::scene("can_breast", 0);
     let snapshot = world.snapshot();
     let w = snapshot.world().unwrap();
-    let query = MotionQuery {
-        grasp: &grasp,
-        start: w.robot.model.rest_positions(),
-        lift_height: 0.05,
-        pregrasp_distance: 0.05,
-        retreat_distance: 0.0,
-        seed: 1,
-        max_samples: 5000,
-        recheck: false,
-        clearance: tsukami_trajectory_planner::motion::Clearance::default(),
-        acceleration: None,
-    };
+    let query = MotionQuery::new(&grasp, w.robot.model.rest_positions(), 1);
     let cfg = MotionConfig::default();
     let mut phases = Vec::new();
     let run = |cancel: bool, phases: &mut Vec<String>| {
@@ -206,16 +184,8 @@ fn a_revalidated_grasp_holds_on_its_world_and_fails_once_the_object_moved() {
         let snapshot = world.snapshot();
         let w = snapshot.world().unwrap();
         let query = MotionQuery {
-            grasp: &grasp,
-            start: w.robot.model.rest_positions(),
-            lift_height: 0.05,
-            pregrasp_distance: 0.05,
-            retreat_distance: 0.0,
-            seed: 1,
-            max_samples: 5000,
             recheck: true,
-            clearance: tsukami_trajectory_planner::motion::Clearance::default(),
-            acceleration: None,
+            ..MotionQuery::new(&grasp, w.robot.model.rest_positions(), 1)
         };
         let version = w.version;
         let out = plan_motion(
@@ -260,16 +230,8 @@ fn the_retreat_backs_the_palm_out_against_the_approach() {
     let snapshot = world.snapshot();
     let w = snapshot.world().unwrap();
     let query = MotionQuery {
-        grasp: &grasp,
-        start: w.robot.model.rest_positions(),
-        lift_height: 0.05,
-        pregrasp_distance: 0.05,
         retreat_distance: 0.08,
-        seed: 1,
-        max_samples: 5000,
-        recheck: false,
-        clearance: tsukami_trajectory_planner::motion::Clearance::default(),
-        acceleration: None,
+        ..MotionQuery::new(&grasp, w.robot.model.rest_positions(), 1)
     };
     let m = plan_motion(
         &w,
