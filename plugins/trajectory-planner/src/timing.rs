@@ -233,14 +233,19 @@ mod tests {
         }
     }
 
-    #[test]
-    fn every_joint_stays_within_its_limits_between_samples() {
-        let path = vec![
+    /// Three segments with two sharp corners.
+    fn zigzag() -> Vec<Vec<f64>> {
+        vec![
             vec![0.0, 0.0],
             vec![1.2, -0.3],
             vec![1.25, 0.9],
             vec![-0.4, 0.9],
-        ];
+        ]
+    }
+
+    #[test]
+    fn every_joint_stays_within_its_limits_between_samples() {
+        let path = zigzag();
         let lim = limits();
         let pts = time_path(&path, &lim, 0.0);
         for w in pts.windows(2) {
@@ -265,12 +270,7 @@ mod tests {
 
     #[test]
     fn a_rounded_path_never_stops_between_its_ends_and_keeps_the_limits() {
-        let path = vec![
-            vec![0.0, 0.0],
-            vec![1.2, -0.3],
-            vec![1.25, 0.9],
-            vec![-0.4, 0.9],
-        ];
+        let path = zigzag();
         let lim = limits();
         let sharp = time_path(&path, &lim, 0.0);
         let pts = time_path(&path, &lim, 0.1);
