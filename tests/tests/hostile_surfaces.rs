@@ -41,6 +41,18 @@ struct Surfaces {
     web: SocketAddr,
 }
 
+/// The peak resident memory (VmHWM) of process `pid`, MiB.
+fn peak_mib(pid: u32) -> f64 {
+    let status =
+        std::fs::read_to_string(format!("/proc/{pid}/status")).expect("/proc/<pid>/status");
+    let kb: f64 = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+        .expect("VmHWM in kB");
+    kb / 1024.0
+}
+
 fn loopback() -> String {
     format!("tcp/127.0.0.1:{}", free_loopback_port().unwrap())
 }
@@ -373,6 +385,8 @@ fn plan_the_can(surfaces: &Surfaces, seed: u64) -> serde_json::Value {
 fn every_surface_beside_the_planner_survives_a_hostile_corpus() {
     let started = Instant::now();
     let surfaces = Surfaces::start();
+    let vision_pid = surfaces.vision.0.id();
+    let vision_base = peak_mib(vision_pid);
     let stalled = unread_stream(surfaces.web);
     let grasp = plan_the_can(&surfaces, 1);
     let keys = surfaces.client.keys().clone();
@@ -429,6 +443,17 @@ fn every_surface_beside_the_planner_survives_a_hostile_corpus() {
         seed += 1;
     }
     drop(stalled);
+    // The vision's peak memory over the corpus, against docs/components.md's
+    // bound: B + (Q + 1) × 16 MiB + L × 33 MiB + W, with Q = 8 queued
+    // detections, L = 2 links (the host and this client) and W = 30 MiB for
+    // one detection's image, cloud and clusters.
+    let vision_peak = peak_mib(vision_pid);
+    let bound = vision_base + 9.0 * 16.0 + 2.0 * 33.0 + 30.0;
+    eprintln!("vision VmHWM: {vision_base:.0} MiB after start, {vision_peak:.0} MiB peak (bound {bound:.0} MiB)");
+    assert!(
+        vision_peak <= bound,
+        "the vision peaked at {vision_peak:.0} MiB, over {bound:.0} MiB"
+    );
     eprintln!(
         "hostile surfaces: {} bus cases and {} web cases in {:.0?}",
         cases.len(),
