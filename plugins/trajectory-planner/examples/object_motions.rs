@@ -28,13 +28,12 @@ use objects::{objects, placements, set_env, set_object};
 use serde_json::{json, Value};
 use tsukami_msgs::motion::MotionGrasp;
 use tsukami_msgs::planner::{SetEnv, SetObject, SetRobot};
-use tsukami_planner_kit::validate::Limits;
 use tsukami_planner_kit::{PlannerConfig, Session};
 use tsukami_plugin_api::ffi::FfiHost_TO;
 use tsukami_plugin_api::loader::LoadedLibrary;
 use tsukami_plugin_api::offline::OfflineHost;
 use tsukami_trajectory_planner::error::MotionError;
-use tsukami_trajectory_planner::motion::{plan_motion, MotionConfig, MotionQuery, Variant};
+use tsukami_trajectory_planner::motion::{plan_default, MotionQuery};
 use tsukami_trajectory_planner::world::SharedWorld;
 
 const VALID: &str = "the benchmark's own requests are valid";
@@ -43,17 +42,8 @@ const VALID: &str = "the benchmark's own requests are valid";
 fn motion(world: &Session<SharedWorld>, grasp: &MotionGrasp) -> Result<(), String> {
     let snapshot = world.snapshot();
     let w = snapshot.world().map_err(|e| e.to_string())?;
-    let cfg = MotionConfig::default();
     let query = MotionQuery::new(grasp, w.robot.model.rest_positions(), 0);
-    let out = plan_motion(
-        &w,
-        &query,
-        &cfg,
-        &Limits::default(),
-        Variant::default(),
-        &|| false,
-        &mut |_, _| {},
-    );
+    let out = plan_default(&w, &query);
     match out {
         Ok(_) => Ok(()),
         Err(MotionError::Infeasible {

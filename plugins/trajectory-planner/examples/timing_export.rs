@@ -12,10 +12,7 @@
 mod grasps;
 
 use serde_json::json;
-use tsukami_planner_kit::validate::Limits;
-use tsukami_trajectory_planner::motion::{
-    joint_limits, plan_motion, MotionConfig, MotionQuery, Variant,
-};
+use tsukami_trajectory_planner::motion::{joint_limits, plan_default, MotionConfig, MotionQuery};
 
 const SCENES: [&str; 5] = [
     "can_breast",
@@ -36,16 +33,7 @@ fn main() {
         let snapshot = world.snapshot();
         let w = snapshot.world().expect("a world");
         let query = MotionQuery::new(&grasp, w.robot.model.rest_positions(), 1);
-        let m = plan_motion(
-            &w,
-            &query,
-            &cfg,
-            &Limits::default(),
-            Variant::default(),
-            &|| false,
-            &mut |_, _| {},
-        )
-        .unwrap_or_else(|e| panic!("{scene}: {e}"));
+        let m = plan_default(&w, &query).unwrap_or_else(|e| panic!("{scene}: {e}"));
         let t = &m.trajectory;
         let ids: Vec<usize> = t
             .joint_names

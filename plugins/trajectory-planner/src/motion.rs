@@ -387,6 +387,24 @@ fn timed(
     trajectory
 }
 
+/// [`plan_motion`] with the default config and world limits, every phase
+/// (no variant), never cancelled, no progress: for tests, examples and
+/// benchmarks.
+pub fn plan_default(
+    world: &World<'_, SharedWorld>,
+    query: &MotionQuery<'_>,
+) -> Result<Motion, MotionError> {
+    plan_motion(
+        world,
+        query,
+        &MotionConfig::default(),
+        &Limits::default(),
+        Variant::default(),
+        &|| false,
+        &mut |_, _| {},
+    )
+}
+
 /// The time scaling's limits of `joints`: each joint's URDF velocity (the
 /// config's `default_velocity` when it states none), its acceleration —
 /// `acceleration` (a request's) when given, else the robot description's,

@@ -7,24 +7,16 @@ mod common;
 
 use tsukami_msgs::motion::{JointTrajectory, MotionGrasp};
 use tsukami_planner_kit::validate::Limits;
-use tsukami_trajectory_planner::motion::{plan_motion, Motion, MotionConfig, MotionQuery, Variant};
+use tsukami_trajectory_planner::motion::{
+    plan_default, plan_motion, Motion, MotionConfig, MotionQuery, Variant,
+};
 
 fn motion(scene: &str, seed: u64) -> (Motion, MotionGrasp) {
     let (world, grasp) = common::grasps::scene(scene, 0);
     let snapshot = world.snapshot();
     let w = snapshot.world().unwrap();
     let query = MotionQuery::new(&grasp, w.robot.model.rest_positions(), seed);
-    let cfg = MotionConfig::default();
-    let m = plan_motion(
-        &w,
-        &query,
-        &cfg,
-        &Limits::default(),
-        Variant::default(),
-        &|| false,
-        &mut |_, _| {},
-    )
-    .unwrap_or_else(|e| panic!("{scene}: {e}"));
+    let m = plan_default(&w, &query).unwrap_or_else(|e| panic!("{scene}: {e}"));
     (m, grasp)
 }
 
@@ -188,15 +180,7 @@ fn a_revalidated_grasp_holds_on_its_world_and_fails_once_the_object_moved() {
             ..MotionQuery::new(&grasp, w.robot.model.rest_positions(), 1)
         };
         let version = w.version;
-        let out = plan_motion(
-            &w,
-            &query,
-            &MotionConfig::default(),
-            &Limits::default(),
-            Variant::default(),
-            &|| false,
-            &mut |_, _| {},
-        );
+        let out = plan_default(&w, &query);
         (out, version)
     };
     let (same, _) = plan(&world);
@@ -233,16 +217,7 @@ fn the_retreat_backs_the_palm_out_against_the_approach() {
         retreat_distance: 0.08,
         ..MotionQuery::new(&grasp, w.robot.model.rest_positions(), 1)
     };
-    let m = plan_motion(
-        &w,
-        &query,
-        &MotionConfig::default(),
-        &Limits::default(),
-        Variant::default(),
-        &|| false,
-        &mut |_, _| {},
-    )
-    .expect("a motion with a retreat");
+    let m = plan_default(&w, &query).expect("a motion with a retreat");
     let t = &m.trajectory;
     let mut phases: Vec<&str> = t.points.iter().map(|p| p.phase.as_str()).collect();
     phases.dedup();
