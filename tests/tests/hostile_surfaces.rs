@@ -4,8 +4,9 @@
 //! vision — over a real zenoh bus on loopback (tcp/127.0.0.1, scouting off).
 //!
 //! The host (grasp planner, trajectory planner, result viewer) runs in this
-//! process, the controller too (its library, on a port of its own), the vision as
-//! its own `tsukami-vision serve` process. Every key gets the garbage payloads, and
+//! process, the controller as its own `tsukami-controller` process and the vision
+//! as its own `tsukami-vision serve` process (so that each one's peak memory is
+//! its own to read). Every key gets the garbage payloads, and
 //! each surface its own hostile requests: trajectories with no points, far or
 //! unsorted times and unknown joints; depth frames whose size, data or camera
 //! lie; pictures of absurd sizes; the host's own `world_prepare`/`commit`/`abort`
@@ -20,7 +21,7 @@ use std::net::{SocketAddr, TcpStream};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 use tsukami::client::{BusClient, RequestError};
-use tsukami_bus::{free_loopback_port, BusConfig, ComponentArgs};
+use tsukami_bus::{free_loopback_port, BusConfig};
 use tsukami_e2e::hostile::{check_well_formed, garbage};
 use tsukami_e2e::{
     component_exe, models_dir, motion_entry, planner_entry, test_config, viewer_entry, ChildGuard,
@@ -35,7 +36,7 @@ const CASE_LIMIT: Duration = Duration::from_secs(10);
 /// Everything under test and a client that reaches all of it.
 struct Surfaces {
     bus: TestBus,
-    controller: tsukami_controller::ControllerNode,
+    controller: ChildGuard,
     vision: ChildGuard,
     client: BusClient,
     web: SocketAddr,
@@ -57,21 +58,19 @@ fn loopback() -> String {
     format!("tcp/127.0.0.1:{}", free_loopback_port().unwrap())
 }
 
-/// The real controller, in this process, listening on `endpoint`.
-fn controller(namespace: &str, endpoint: &str) -> tsukami_controller::ControllerNode {
-    use tsukami_controller::{Executor, JointTable, NodeOptions};
-    let args = ComponentArgs {
-        listen: vec![endpoint.to_owned()],
-        connect: vec![],
-        ..ComponentArgs::connecting(namespace, endpoint)
-    };
-    let table = JointTable::load("tsukami_humanoid", &models_dir()).unwrap();
-    let executor = Executor::new(table, 100.0, None).unwrap();
-    let options = NodeOptions {
-        speed: 1.0,
-        start_tolerance: 0.01,
-    };
-    tsukami_controller::start(&args, executor, options).expect("the controller starts")
+/// The real `tsukami-controller` (the humanoid, 100 Hz, real time) listening on
+/// `endpoint`.
+fn controller(namespace: &str, endpoint: &str) -> ChildGuard {
+    let exe = component_exe("tsukami-controller", "tsukami-controller");
+    let child = Command::new(exe)
+        .args(["--listen", endpoint, "--namespace", namespace])
+        .arg("--models-dir")
+        .arg(models_dir())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("the controller starts");
+    ChildGuard(child)
 }
 
 /// `tsukami-vision serve` listening on `endpoint`, sending poses to the host.
@@ -387,6 +386,8 @@ fn every_surface_beside_the_planner_survives_a_hostile_corpus() {
     let surfaces = Surfaces::start();
     let vision_pid = surfaces.vision.0.id();
     let vision_base = peak_mib(vision_pid);
+    let controller_pid = surfaces.controller.0.id();
+    let controller_base = peak_mib(controller_pid);
     let stalled = unread_stream(surfaces.web);
     let grasp = plan_the_can(&surfaces, 1);
     let keys = surfaces.client.keys().clone();
@@ -454,6 +455,15 @@ fn every_surface_beside_the_planner_survives_a_hostile_corpus() {
         vision_peak <= bound,
         "the vision peaked at {vision_peak:.0} MiB, over {bound:.0} MiB"
     );
+    // The controller's, the same way: W = 40 MiB for one trajectory at the
+    // payload cap parsed (the 100,000-point case) and its interpolation table.
+    let controller_peak = peak_mib(controller_pid);
+    let bound = controller_base + 9.0 * 16.0 + 2.0 * 33.0 + 40.0;
+    eprintln!("controller VmHWM: {controller_base:.0} MiB after start, {controller_peak:.0} MiB peak (bound {bound:.0} MiB)");
+    assert!(
+        controller_peak <= bound,
+        "the controller peaked at {controller_peak:.0} MiB, over {bound:.0} MiB"
+    );
     eprintln!(
         "hostile surfaces: {} bus cases and {} web cases in {:.0?}",
         cases.len(),
@@ -468,7 +478,7 @@ fn every_surface_beside_the_planner_survives_a_hostile_corpus() {
         ..
     } = surfaces;
     client.close();
-    controller.shutdown();
+    drop(controller);
     drop(vision);
     drop(bus);
 }
