@@ -21,7 +21,11 @@
 //! a pad in series with the finger it sits on, the fingers coupled through
 //! shared joints; a palm contact (a zero Jacobian) is the pad alone. The
 //! object's stiffness is `K = G K_c Gᵀ`, and a wrench `w` moves it by
-//! `δx = K⁻¹ w` (`None` when `K` is singular: some motion is not resisted).
+//! `δx = K⁻¹ w` (`None` when `K` is singular: some motion is not resisted),
+//! and each contact's force changes by `δfᵢ = −(K_c Gᵀ δx)ᵢ`
+//! ([`GraspStiffness::force_change`]): the forces the hand really makes under
+//! the load, which must stay inside the friction cones for the object to
+//! stay put.
 //!
 //! ```
 //! use nalgebra::{Matrix3xX, Point3, Vector3};
@@ -33,8 +37,12 @@
 //! let jac = vec![Matrix3xX::zeros(0); 3];
 //! let k = GraspStiffness::new(&points, &Point3::origin(), &jac, &[], 1000.0).unwrap();
 //! // 3 N down: three pads share it, 1 mm each.
-//! let d = k.displacement(&Wrench::new(0.0, 0.0, -3.0, 0.0, 0.0, 0.0)).unwrap();
+//! let w = Wrench::new(0.0, 0.0, -3.0, 0.0, 0.0, 0.0);
+//! let d = k.displacement(&w).unwrap();
 //! assert!((d.shift.z + 0.001).abs() < 1e-9 && d.turn.norm() < 1e-9);
+//! // The pads push back 1 N up each: the forces balance the pull.
+//! let df = k.force_change(&w).unwrap();
+//! assert!(df.iter().all(|f| (f.z - 1.0).abs() < 1e-9));
 //! ```
 
 use nalgebra::{DMatrix, Matrix3xX, Matrix6, Point3, Vector3};
@@ -55,6 +63,8 @@ pub struct Displacement {
 #[derive(Debug, Clone, PartialEq)]
 pub struct GraspStiffness {
     stiffness: Matrix6<f64>,
+    /// `K_c Gᵀ` (3n × 6): the contact forces' change per object twist.
+    response: DMatrix<f64>,
 }
 
 impl GraspStiffness {
@@ -96,9 +106,11 @@ impl GraspStiffness {
             g.view_mut((0, 3 * i), (6, 3))
                 .copy_from(&contact_block(&c, reference, 1.0));
         }
-        let k = &g * kc * g.transpose();
+        let response = kc * g.transpose();
+        let k = &g * &response;
         Some(Self {
             stiffness: Matrix6::from_iterator(k.iter().copied()),
+            response,
         })
     }
 
@@ -115,5 +127,23 @@ impl GraspStiffness {
             shift: x.fixed_rows::<3>(0).into_owned(),
             turn: x.fixed_rows::<3>(3).into_owned(),
         })
+    }
+
+    /// The change of each contact's force on the object when an external
+    /// wrench `w` is applied: the object moves by `δx = K⁻¹ w` and the pads
+    /// and fingers push back, `δf = −K_c Gᵀ δx` (so `Σ δfᵢ` balances `w`).
+    /// The forces a compliant hand really makes, not merely forces that
+    /// exist; `None` when some motion is not resisted.
+    pub fn force_change(&self, w: &Wrench) -> Option<Vec<Vector3<f64>>> {
+        let x = self.stiffness.cholesky()?.solve(w);
+        let x = DMatrix::from_column_slice(6, 1, x.as_slice());
+        let df = -(&self.response * x);
+        let n = df.nrows() / 3;
+        let out: Vec<Vector3<f64>> = (0..n)
+            .map(|i| Vector3::new(df[3 * i], df[3 * i + 1], df[3 * i + 2]))
+            .collect();
+        out.iter()
+            .all(|v| v.iter().all(|c| c.is_finite()))
+            .then_some(out)
     }
 }

@@ -690,6 +690,14 @@ pub struct HoldCompliance {
     pub turn_deg: f64,
     /// Largest shift of the centre of mass, mm.
     pub shift_mm: f64,
+    /// The compliant hand's largest `‖f_t‖ / (μ f_n)` of any contact under
+    /// any of the six pulls, squeezing with the reply's squeeze
+    /// (docs/force-closure.md); absent when a contact lets go under some pull.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_use: Option<f64>,
+    /// Its largest `|τ| / effort` of any hand joint under any pull.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub torque_use: Option<f64>,
 }
 
 /// How many of the sampled object pose errors the grasp still holds under:
@@ -893,6 +901,8 @@ mod tests {
                 compliance: Some(HoldCompliance {
                     turn_deg: 2.5,
                     shift_mm: 1.2,
+                    friction_use: Some(0.6),
+                    torque_use: Some(0.95),
                 }),
             },
             squeeze: vec![JointSqueeze {

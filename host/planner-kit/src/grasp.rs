@@ -152,6 +152,11 @@ pub fn reply<P: GraspPlanner>(
             compliance: verdict.compliance.map(|(t, s)| HoldCompliance {
                 turn_deg: t.to_degrees(),
                 shift_mm: s * 1e3,
+                friction_use: verdict
+                    .passive
+                    .map(|p| p.friction_use)
+                    .filter(|u| u.is_finite()),
+                torque_use: verdict.passive.map(|p| p.torque_use),
             }),
         },
         squeeze: verdict.squeeze.clone(),

@@ -37,7 +37,8 @@ use tsukami_body::model::LinkId;
 
 use crate::blocks::grasp_check::check_in;
 use crate::blocks::hold::{
-    compliance, holds_exactly, holds_under, squeeze, HoldContact, HoldProblem,
+    compliance, holds_exactly, holds_under, passive_response, squeeze, HoldContact, HoldProblem,
+    PassiveResponse,
 };
 use crate::blocks::robust::{pose_robustness, RobustProblem};
 use crate::blocks::wrap::{style_check, StyleRule};
@@ -77,6 +78,9 @@ pub struct Verdict {
     /// The worst turn (rad) and shift (m) under the six pulls
     /// ([`crate::blocks::hold::compliance`]).
     pub compliance: Option<(f64, f64)>,
+    /// The compliant hand's use of friction and effort under the six pulls
+    /// ([`crate::blocks::hold::passive_response`]).
+    pub passive: Option<PassiveResponse>,
 }
 
 /// The paper's single maximum finger force of a contact set: the weakest `f_max`.
@@ -113,6 +117,7 @@ pub fn force_closure(object: &Object, contacts: &[FingerContact], length: f64) -
         squeeze: Vec::new(),
         robustness: PoseRobustness::default(),
         compliance: None,
+        passive: None,
     })
 }
 
@@ -313,6 +318,7 @@ fn hold_checks<P: GraspPlanner>(
     style_check(&style_rule(world, grasp, &fk), &contacts)?;
     let v = holds_exactly(&problem, &contacts, req)?;
     verdict.compliance = compliance(&problem, &contacts);
+    verdict.passive = passive_response(&problem, &contacts, req);
     verdict.force_closure = v.force_closure;
     verdict.hold_margin = v.margin;
     verdict.disturbances = req.disturbances;

@@ -330,6 +330,9 @@ impl Paper {
             t.any_reachable = true;
             // Approaches the support or an obstacle blocks go last; then by cost.
             nominals.sort_by(|a, b| a.blocked.cmp(&b.blocked).then(a.cost.total_cmp(&b.cost)));
+            // The best grasp some pose error drops: taken only when no other
+            // nominal pose of this stage gives one that holds under all.
+            let mut partial: Option<(u32, Grasp)> = None;
             for (k, nom) in nominals
                 .iter()
                 .take(opts.max_candidates.max(1) as usize)
@@ -369,12 +372,23 @@ impl Paper {
                             object,
                         )));
                     }
+                    Outcome::Partial(found) => {
+                        let held = found.robustness.held;
+                        if partial.as_ref().is_none_or(|(h, _)| held > *h) {
+                            let g = grasp(g.to_ref(), &nom.candidate, &stage, *found, object);
+                            partial = Some((held, g));
+                        }
+                    }
                     Outcome::Cancelled => return Err(Stop::Cancelled.into()),
                     Outcome::OutOfTime => {
                         return Err(run.check().err().unwrap_or(Stop::Cancelled).into())
                     }
                     Outcome::Exhausted => {}
                 }
+            }
+            if let Some((_, g)) = partial {
+                run.phase(PlanPhase::Verification, Some(&g.grasp_type.name), &extra);
+                return Ok(Some(g));
             }
         }
         Ok(None)

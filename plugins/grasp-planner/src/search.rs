@@ -146,6 +146,9 @@ pub struct Found {
 pub enum Outcome {
     /// A grasp was found.
     Found(Box<Found>),
+    /// The samples ran out with accepted grasps that some object pose error
+    /// drops: the one that held under the most.
+    Partial(Box<Found>),
     /// All samples were used.
     Exhausted,
     /// The cancel flag was set.
@@ -229,7 +232,8 @@ pub type Judge<'h> = dyn FnMut(&Found) -> Result<PoseRobustness, String> + 'h;
 /// first accepted grasp that holds under every pose error is returned; one that some error drops
 /// is kept while the search goes on for at most [`ROBUST_EXTRA_SAMPLES`]
 /// samples, and the one that held under the most (the first of equals) is
-/// returned then.
+/// returned then as [`Outcome::Partial`]: the caller tries its other nominal
+/// poses before it takes it.
 #[allow(clippy::too_many_arguments)]
 pub fn search(
     ctx: &SearchContext<'_>,
@@ -276,7 +280,7 @@ pub fn search(
         &stop_at,
     );
     match (outcome, best) {
-        (Outcome::Exhausted, Some(b)) => Outcome::Found(b),
+        (Outcome::Exhausted, Some(b)) => Outcome::Partial(b),
         (o, _) => o,
     }
 }

@@ -32,6 +32,7 @@ pub mod goal;
 pub mod motion;
 pub mod plugin;
 pub mod revalidate;
+pub mod rounding;
 pub mod rrt_connect;
 pub mod shortcut;
 pub mod squeeze;

@@ -35,7 +35,6 @@
 use tsukami_body::model::JointId;
 use tsukami_msgs::motion::{JointTrajectory, MotionGrasp};
 use tsukami_planner_kit::motion_check::checker::RobotWorld;
-use tsukami_planner_kit::motion_check::phases::first_blocked;
 pub use tsukami_planner_kit::motion_check::phases::{check_path, Clearance, OPENINGS};
 use tsukami_planner_kit::motion_check::phases::{check_phases, Blocked, PhaseParams, PhaseScene};
 use tsukami_planner_kit::validate::Limits;
@@ -44,6 +43,7 @@ use tsukami_planner_kit::World;
 use crate::assemble::{assemble, Phase};
 use crate::error::MotionError;
 use crate::goal::{resolve, Goal};
+use crate::rounding::timed_phase;
 use crate::rrt_connect::{plan_counted, Problem, RrtError, RrtParams};
 use crate::shortcut::shortcut;
 use crate::timing;
@@ -348,7 +348,7 @@ fn reach_error(
 /// The phases timed and joined, with the grasp's squeeze as the command from
 /// the end of `close` on. Each phase's corners are rounded as much as
 /// [`MotionConfig::blend_deviation`] allows without a collision
-/// ([`timed_phase`]).
+/// ([`crate::rounding::timed_phase`]).
 fn timed(
     s: &mut PhaseScene<'_>,
     query: &MotionQuery<'_>,
@@ -459,53 +459,4 @@ pub fn joint_limits(
         sample_dt: cfg.sample_dt,
         jerk,
     }
-}
-
-/// How many times a phase's rounding is tightened before it stops at its
-/// waypoints ([`timed_phase`]).
-const ROUNDING_TRIES: usize = 24;
-
-/// One phase timed with its corners rounded by `deviation`: the sampled
-/// polyline (what the controller follows) is checked with `world`, and the
-/// corner nearest the first collision rounds a quarter as much, down to not
-/// at all, until it is clear. Unrounded, the samples lie on the checked path.
-fn timed_phase(
-    s: &mut PhaseScene<'_>,
-    mut world: RobotWorld<'_>,
-    path: &[Vec<f64>],
-    limits: &timing::Limits,
-    deviation: f64,
-) -> Vec<timing::TimedPoint> {
-    let mut dev = vec![deviation; path.len()];
-    for _ in 0..ROUNDING_TRIES {
-        let points = timing::time_path_with(path, limits, &dev);
-        let polyline: Vec<Vec<f64>> = points.iter().map(|p| p.positions.clone()).collect();
-        let blocked = first_blocked(&mut world, &polyline);
-        s.checks += world.checks();
-        let Err((k, _)) = blocked else {
-            return points;
-        };
-        let (a, b) = (&polyline[k], &polyline[(k + 1).min(polyline.len() - 1)]);
-        let Some(c) = nearest_corner(path, a, b) else {
-            break;
-        };
-        dev[c] = if dev[c] > deviation / 64.0 {
-            dev[c] / 4.0
-        } else {
-            0.0
-        };
-    }
-    timing::time_path(path, limits, 0.0)
-}
-
-/// The interior waypoint of `path` nearest the segment `a`–`b`'s midpoint.
-fn nearest_corner(path: &[Vec<f64>], a: &[f64], b: &[f64]) -> Option<usize> {
-    let mid: Vec<f64> = a.iter().zip(b).map(|(x, y)| 0.5 * (x + y)).collect();
-    let d = |q: &[f64]| {
-        q.iter()
-            .zip(&mid)
-            .map(|(x, y)| (x - y).powi(2))
-            .sum::<f64>()
-    };
-    (1..path.len().saturating_sub(1)).min_by(|&i, &j| d(&path[i]).total_cmp(&d(&path[j])))
 }

@@ -269,8 +269,24 @@ pub const PAD_STIFFNESS: f64 = 5000.0;
 /// (`tsukami_grasp::stiffness`): the largest turn (rad) and shift (m);
 /// `None` when some motion is not resisted at all.
 pub fn compliance(p: &HoldProblem<'_>, contacts: &[HoldContact]) -> Option<(f64, f64)> {
-    let servo_saturation = p.servo_saturation;
     let (_, torques) = setup(p, contacts)?;
+    let k = stiffness(p, &torques, contacts)?;
+    let (mut turn, mut shift) = (0.0f64, 0.0f64);
+    for w in weight_pulls(p.mass) {
+        let d = k.displacement(&w)?;
+        turn = turn.max(d.turn.norm());
+        shift = shift.max(d.shift.norm());
+    }
+    Some((turn, shift))
+}
+
+/// The grasp's stiffness about the centre of mass: the hand's joints as
+/// servos of `effort / servo_saturation`, pads of [`PAD_STIFFNESS`].
+fn stiffness(
+    p: &HoldProblem<'_>,
+    torques: &JointTorques,
+    contacts: &[HoldContact],
+) -> Option<GraspStiffness> {
     let points: Vec<Point3<f64>> = contacts.iter().map(|(_, x, _)| *x).collect();
     let jac: Vec<_> = (0..points.len())
         .map(|i| torques.jacobian(i).clone())
@@ -278,18 +294,70 @@ pub fn compliance(p: &HoldProblem<'_>, contacts: &[HoldContact]) -> Option<(f64,
     let springs: Vec<f64> = torques
         .efforts()
         .iter()
-        .map(|e| (e / servo_saturation.max(1e-6)).max(1e-9))
+        .map(|e| (e / p.servo_saturation.max(1e-6)).max(1e-9))
         .collect();
-    let k = GraspStiffness::new(&points, &p.com, &jac, &springs, PAD_STIFFNESS)?;
-    let (mut turn, mut shift) = (0.0f64, 0.0f64);
-    for axis in 0..3 {
-        for sign in [-1.0, 1.0] {
-            let mut w = tsukami_grasp::grasp_matrix::Wrench::zeros();
-            w[axis] = sign * p.mass * G;
-            let d = k.displacement(&w)?;
-            turn = turn.max(d.turn.norm());
-            shift = shift.max(d.shift.norm());
+    GraspStiffness::new(&points, &p.com, &jac, &springs, PAD_STIFFNESS)
+}
+
+/// The object's weight pulling along −x, +x, −y, +y, −z, +z at the centre
+/// of mass.
+fn weight_pulls(mass: f64) -> impl Iterator<Item = tsukami_grasp::grasp_matrix::Wrench> {
+    (0..6).map(move |k| {
+        let mut w = tsukami_grasp::grasp_matrix::Wrench::zeros();
+        w[k / 2] = if k % 2 == 0 { -1.0 } else { 1.0 } * mass * G;
+        w
+    })
+}
+
+/// What the compliant hand does under the six pulls of the weight
+/// ([`passive_response`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PassiveResponse {
+    /// The largest `‖f_t‖ / (μ f_n)` of any contact under any pull (the
+    /// full friction coefficient; infinite when a contact lets go).
+    pub friction_use: f64,
+    /// The largest `|τⱼ| / effortⱼ` of any hand joint under any pull.
+    pub torque_use: f64,
+}
+
+/// The forces the hand really makes, not forces that merely exist: the
+/// fingers press with the [`squeeze`]'s forces `f₀`, then each pull of the
+/// weight moves the object by the grasp's compliance and changes the contact
+/// forces by `δf` (`tsukami_grasp::stiffness::GraspStiffness::force_change`).
+/// The object stays put only while every `f₀ + δf` stays inside its friction
+/// cone and every joint within its effort; this says how much of both the
+/// worst pull uses. `None` when the squeeze or the stiffness cannot be
+/// computed.
+pub fn passive_response(
+    p: &HoldProblem<'_>,
+    contacts: &[HoldContact],
+    req: &HoldRequest,
+) -> Option<PassiveResponse> {
+    let (grasp, torques) = setup(p, contacts)?;
+    let s =
+        tsukami_grasp::hold::squeeze(&grasp, &torques, req.squeeze_share, &options(req)).ok()?;
+    let k = stiffness(p, &torques, contacts)?;
+    let mut out = PassiveResponse {
+        friction_use: 0.0,
+        torque_use: 0.0,
+    };
+    for w in weight_pulls(p.mass) {
+        let df = k.force_change(&w)?;
+        let f: Vec<Vector3<f64>> = s.forces.iter().zip(&df).map(|(a, b)| a + b).collect();
+        for ((_, _, n), fi) in contacts.iter().zip(&f) {
+            let normal = n.dot(fi);
+            let tangential = (fi - n * normal).norm();
+            let used = match normal > 1e-9 {
+                true => tangential / (p.mu * normal),
+                false => f64::INFINITY,
+            };
+            out.friction_use = out.friction_use.max(used);
+        }
+        for (t, e) in torques.torques(&f).iter().zip(torques.efforts()) {
+            if *e > 0.0 {
+                out.torque_use = out.torque_use.max(t.abs() / e);
+            }
         }
     }
-    Some((turn, shift))
+    Some(out)
 }
