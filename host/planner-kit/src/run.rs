@@ -124,6 +124,17 @@ impl<'a> Run<'a> {
         }
     }
 
+    /// The exact hold margin of `grasp` under `req`, `None` when it does not
+    /// hold ([`crate::verify::hold_margin`]).
+    pub fn hold_margin<P: GraspPlanner>(
+        &self,
+        world: &World<'_, P>,
+        grasp: &Grasp,
+        req: &HoldRequest,
+    ) -> Option<f64> {
+        crate::verify::hold_margin(world, grasp, req)
+    }
+
     /// How many of the request's object pose errors `grasp` still holds
     /// under ([`crate::verify::robustness`], the kit's re-check). The last
     /// answer is kept, so the verification of the grasp a planner chose on it

@@ -233,6 +233,7 @@ pub fn hold_request(h: &tsukami_msgs::planner::HoldRequest) -> Result<(), KitErr
     if let Some(s) = h.max_shift_mm {
         ranged(s, "max_shift_mm", 0.0, 100.0, true)?;
     }
+    ranged(h.preferred_margin, "preferred_margin", 1.0, 100.0, false)?;
     let e = &h.pose_error;
     ranged(e.position, "pose_error.position", 0.0, 0.05, false)?;
     ranged(e.rotation_deg, "pose_error.rotation_deg", 0.0, 30.0, false)?;

@@ -274,6 +274,24 @@ pub fn robustness<P: GraspPlanner>(
     pose_robustness(&problem, &grasp.q, &grasp.contacts, req, seed)
 }
 
+/// The exact hold margin of `grasp` under `req` (the reply's `hold_margin`:
+/// the multiple of every disturbance it resists), `None` when it does not
+/// hold. Planners rank their accepted grasps by it
+/// (`HoldRequest::preferred_margin`).
+pub fn hold_margin<P: GraspPlanner>(
+    world: &World<'_, P>,
+    grasp: &Grasp,
+    req: &HoldRequest,
+) -> Option<f64> {
+    let model = &world.robot.model;
+    let mut fk = FkState::new(model);
+    model.forward_kinematics(&grasp.q, &mut fk);
+    let problem = hold_problem(world, &fk, grasp_length(world, grasp));
+    holds_exactly(&problem, &hold_contacts(&grasp.contacts), req)
+        .ok()
+        .map(|v| v.margin)
+}
+
 /// The characteristic length of `grasp`: its own when valid, else the object's.
 fn grasp_length<P: GraspPlanner>(world: &World<'_, P>, grasp: &Grasp) -> f64 {
     grasp

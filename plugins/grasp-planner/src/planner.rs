@@ -48,7 +48,7 @@ use crate::link_sets::LinkSets;
 use crate::object::PlanObject;
 use crate::ocp::{Ocp, OcpParams};
 use crate::palm_pose::{criterion_value, palm_targets};
-use crate::search::{search, Counters, Found, Outcome, SearchContext, SearchParams};
+use crate::search::{search, Counters, Found, Judged, Outcome, SearchContext, SearchParams};
 use crate::selection::{select, Candidate, Selection};
 use crate::tilt::tilts;
 use crate::whole_body::{stages, StageJoints};
@@ -330,9 +330,11 @@ impl Paper {
             t.any_reachable = true;
             // Approaches the support or an obstacle blocks go last; then by cost.
             nominals.sort_by(|a, b| a.blocked.cmp(&b.blocked).then(a.cost.total_cmp(&b.cost)));
-            // The best grasp some pose error drops: taken only when no other
-            // nominal pose of this stage gives one that holds under all.
-            let mut partial: Option<(u32, Grasp)> = None;
+            // The best grasp that is not preferred (some pose error drops it,
+            // or its hold margin is below the preferred one): taken only when
+            // no other nominal pose of this stage gives a preferred one.
+            let pm = opts.hold.preferred_margin;
+            let mut partial: Option<((u32, f64), Grasp)> = None;
             for (k, nom) in nominals
                 .iter()
                 .take(opts.max_candidates.max(1) as usize)
@@ -357,7 +359,10 @@ impl Paper {
                     &mut |found| {
                         let g = grasp(g.to_ref(), &nom.candidate, &stage, found.clone(), object);
                         run.motion_phases(w, &g).map_err(|b| b.to_string())?;
-                        Ok(run.pose_robustness(w, &g, &opts.hold, opts.seed))
+                        Ok(Judged {
+                            robustness: run.pose_robustness(w, &g, &opts.hold, opts.seed),
+                            hold_margin: run.hold_margin(w, &g, &opts.hold).unwrap_or(0.0),
+                        })
                     },
                 );
                 run.record(t.counters.samples, t.counters.best_margin);
@@ -373,10 +378,10 @@ impl Paper {
                         )));
                     }
                     Outcome::Partial(found) => {
-                        let held = found.robustness.held;
-                        if partial.as_ref().is_none_or(|(h, _)| held > *h) {
+                        let rank = found.rank(pm);
+                        if partial.as_ref().is_none_or(|(r, _)| rank > *r) {
                             let g = grasp(g.to_ref(), &nom.candidate, &stage, *found, object);
-                            partial = Some((held, g));
+                            partial = Some((rank, g));
                         }
                     }
                     Outcome::Cancelled => return Err(Stop::Cancelled.into()),

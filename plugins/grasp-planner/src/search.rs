@@ -139,6 +139,31 @@ pub struct Found {
     pub exact_ms: f64,
     /// Of the request's object pose errors, how many it still holds under.
     pub robustness: PoseRobustness,
+    /// The exact hold margin (the multiple of every disturbance it resists).
+    pub hold_margin: f64,
+}
+
+impl Found {
+    /// Whether it is a grasp the planner prefers: it holds under every pose
+    /// error and resists `preferred_margin` times every disturbance.
+    pub fn preferred(&self, preferred_margin: f64) -> bool {
+        self.robustness.held == self.robustness.samples && self.hold_margin >= preferred_margin
+    }
+
+    /// Its rank among grasps that are not preferred (higher is better): the
+    /// pose errors it holds under, then its margin up to `preferred_margin`.
+    pub fn rank(&self, preferred_margin: f64) -> (u32, f64) {
+        (self.robustness.held, self.hold_margin.min(preferred_margin))
+    }
+}
+
+/// What the kit says of an accepted grasp ([`Judge`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Judged {
+    /// Of the request's object pose errors, how many it still holds under.
+    pub robustness: PoseRobustness,
+    /// Its exact hold margin.
+    pub hold_margin: f64,
 }
 
 /// How a search ended.
@@ -171,8 +196,8 @@ pub const REJECTION_REASONS: [&str; 10] = [
     "motion blocked",
 ];
 
-/// Samples a search goes on drawing, after its first accepted grasp that
-/// some pose error drops, for one that holds under all of them.
+/// Samples a search goes on drawing, after its first accepted grasp that is
+/// not preferred ([`Found::preferred`]), for one that is.
 pub const ROBUST_EXTRA_SAMPLES: u32 = 48;
 
 /// The gap (m) a palm-contact grasp type leaves between palm and object
@@ -223,15 +248,17 @@ impl Counters {
 /// (`tsukami_planner_kit::Run`): `Err` (why) when the approach, closing or lift
 /// it implies is blocked (`Run::motion_phases`, the trajectory planner's
 /// checks), else how many of the request's object pose errors it still holds
-/// under (`Run::pose_robustness`).
-pub type Judge<'h> = dyn FnMut(&Found) -> Result<PoseRobustness, String> + 'h;
+/// under (`Run::pose_robustness`) and its exact hold margin
+/// (`Run::hold_margin`).
+pub type Judge<'h> = dyn FnMut(&Found) -> Result<Judged, String> + 'h;
 
 /// Algorithm 1 around one nominal pose. `q_nominal` is the nominal IK solution
 /// (full vector) for grasp type `t` over `stage`. An accepted grasp whose
 /// approach, closing or lift is blocked is a rejection (`motion blocked`). The
-/// first accepted grasp that holds under every pose error is returned; one that some error drops
+/// first preferred grasp ([`Found::preferred`]: it holds under every pose
+/// error with the request's `preferred_margin`) is returned; one that is not
 /// is kept while the search goes on for at most [`ROBUST_EXTRA_SAMPLES`]
-/// samples, and the one that held under the most (the first of equals) is
+/// samples, and the best kept ([`Found::rank`], the first of equals) is
 /// returned then as [`Outcome::Partial`]: the caller tries its other nominal
 /// poses before it takes it.
 #[allow(clippy::too_many_arguments)]
@@ -254,25 +281,30 @@ pub fn search(
         seed,
         counters,
         &mut |found, at, counters| {
-            let r = match judge(&found) {
-                Ok(r) => r,
+            let j = match judge(&found) {
+                Ok(j) => j,
                 Err(why) => {
                     counters.reject(9, Some(why));
                     return None;
                 }
             };
             let found = Box::new(Found {
-                robustness: r,
+                robustness: j.robustness,
+                hold_margin: j.hold_margin,
                 ..found
             });
-            if r.held == r.samples {
+            let preferred = ctx.params.hold.preferred_margin;
+            if found.preferred(preferred) {
                 return Some(Outcome::Found(found));
             }
             counters.reject(7, None);
             if best.is_none() {
                 stop_at.set(at.saturating_add(ROBUST_EXTRA_SAMPLES));
             }
-            if best.as_ref().is_none_or(|b| r.held > b.robustness.held) {
+            if best
+                .as_ref()
+                .is_none_or(|b| found.rank(preferred) > b.rank(preferred))
+            {
                 best = Some(found);
             }
             None
@@ -376,6 +408,7 @@ fn sample_loop(
             exact_resists_weight: true,
             exact_ms,
             robustness: PoseRobustness::default(),
+            hold_margin: 0.0,
         };
         if let Some(done) = on_found(found, s, counters) {
             return done;
