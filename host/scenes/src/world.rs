@@ -12,7 +12,8 @@
 //! `tsukami-body` (models, meshes, collision) is used here, never a planner's code.
 //!
 //! How: names resolve under `models_dir` as the planners resolve them
-//! (`robots/<name>/<name>.urdf`, `objects/<name>/object.toml`); meshes and
+//! (`robots/<name>/<name>.urdf`, `objects/<name>/object.toml`; an inline mesh
+//! is decoded in memory, `tsukami_body::mesh_inline`); meshes and
 //! primitives become one closed triangle mesh, which is both the surface the
 //! contacts are measured against and the collision body. The world frame is the
 //! robot's `base_link` frame, the frame of every message.
@@ -21,10 +22,12 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Isometry3, Point3, Vector3};
 use tsukami_body::collision::{CollisionObject, RobotCollision};
+use tsukami_body::limits::ParseLimits;
 use tsukami_body::mesh::TriangleMesh;
+use tsukami_body::mesh_io::Format;
 use tsukami_body::model::{JointId, LinkId, RobotModel};
 use tsukami_body::object::ObjectModel;
-use tsukami_msgs::planner::{ObjectShape, SetEnv, SetObject, SetRobot};
+use tsukami_msgs::planner::{MeshFormat, ObjectShape, SetEnv, SetObject, SetRobot};
 
 use crate::geometry::{build_obstacle, pose_to_isometry};
 
@@ -253,6 +256,22 @@ fn load_object(models_dir: &Path, req: &SetObject) -> Result<ObjectWorld, WorldE
             let mesh = TriangleMesh::load(Path::new(path), Vector3::repeat(s))
                 .map_err(|e| err("set_object.shape.mesh.path", e))?;
             (path.clone(), mesh, DEFAULT_FRICTION)
+        }
+        ObjectShape::Inline {
+            format,
+            data_base64,
+            scale,
+        } => {
+            let field = "set_object.shape.inline.data_base64";
+            let format = match format {
+                MeshFormat::Stl => Format::Stl,
+                MeshFormat::Obj => Format::Obj,
+            };
+            let s = Vector3::repeat(scale.unwrap_or(1.0));
+            let (mesh, _) =
+                TriangleMesh::from_base64(data_base64, format, s, &ParseLimits::default())
+                    .map_err(|e| err(field, e))?;
+            ("inline".to_owned(), mesh, DEFAULT_FRICTION)
         }
     };
     let mu = req.friction.unwrap_or(default_mu);
