@@ -25,7 +25,7 @@ use tsukami_e2e::{
     models_dir, motion_entry, planner_entry, spawn_tsukami, test_config, tsukami_exe, viewer_entry,
     ChildGuard,
 };
-use tsukami_msgs::keys::{ROLE_GRASP_PLANNER, ROLE_TRAJECTORY_PLANNER};
+use tsukami_msgs::keys::{ROLE_GRASP_PLANNER, ROLE_RESULT_VIEWER, ROLE_TRAJECTORY_PLANNER};
 use tsukami_scenes::scene_requests;
 
 const T: Duration = Duration::from_secs(120);
@@ -135,6 +135,12 @@ fn an_inline_mesh_from_another_process_plans_on_every_plugin() {
         "every plugin took it: {}",
         state["plugins"]
     );
+    // The viewer holds the same world (it draws the inline object).
+    let viewer = c
+        .command(ROLE_RESULT_VIEWER, "state", b"{}", T)
+        .expect("viewer/state");
+    let viewer: Value = serde_json::from_slice(&viewer).unwrap();
+    assert_eq!(viewer["world_version"], v + 1);
     let grasp = plan(&c);
     assert_eq!(grasp["world_version"], v + 1);
     assert_eq!(grasp_of(&grasp), grasp_of(&by_model));

@@ -595,4 +595,32 @@ mod tests {
         let e = build(&models, inline(MeshFormat::Stl, b64(&stl), Some(0.0))).unwrap_err();
         assert_eq!(field_and_message(&e).0, "shape.inline.scale");
     }
+
+    #[test]
+    fn an_inline_mesh_over_max_triangles_names_the_count_and_the_limit() {
+        // 16 MB of OBJ: one triangle more than accepted, within max_mesh_bytes.
+        let mut obj = b"v 0 0 0
+"
+        .to_vec();
+        obj.extend(
+            b"f 1 1 1
+"
+            .repeat(MAX_TRIANGLES + 1),
+        );
+        let models = Models::new([models_dir()]);
+        let e = Object::build(
+            &models,
+            &inline(MeshFormat::Obj, b64(&obj), None),
+            &Limits::default(),
+        )
+        .unwrap_err();
+        let (field, message) = field_and_message(&e);
+        assert_eq!(e.code(), tsukami_msgs::ErrorCode::InvalidValue);
+        assert_eq!(field, "shape.inline.data_base64");
+        assert!(
+            message.contains(&format!("{} triangles", MAX_TRIANGLES + 1))
+                && message.contains("MAX_TRIANGLES = 2000000"),
+            "{message}"
+        );
+    }
 }
