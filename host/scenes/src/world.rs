@@ -302,3 +302,35 @@ fn volume_centroid(mesh: &TriangleMesh) -> Option<Point3<f64>> {
     });
     (volume.abs() > 1e-15).then(|| Point3::from(moment / volume))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tsukami_body::mesh_inline::encode_base64;
+
+    #[test]
+    fn an_inline_object_is_the_object_its_model_is() {
+        let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+        let r = crate::scene_requests(&models.join("scenes/can_breast.toml")).unwrap();
+        let by_model = World::from_requests(&models, &r.robot, &r.object, &r.env).unwrap();
+        let stl = std::fs::read(models.join("objects/can_350ml/can_350ml.stl")).unwrap();
+        let mut object = r.object.clone();
+        object.shape = ObjectShape::Inline {
+            format: MeshFormat::Stl,
+            data_base64: encode_base64(&stl),
+            scale: None,
+        };
+        let inline = World::from_requests(&models, &r.robot, &object, &r.env).unwrap();
+        assert_eq!(inline.object.mesh.indices, by_model.object.mesh.indices);
+        assert_eq!(inline.object.center_of_mass, by_model.object.center_of_mass);
+        assert_eq!(inline.object.mu, by_model.object.mu);
+        object.shape = ObjectShape::Inline {
+            format: MeshFormat::Obj,
+            data_base64: "%%%%".into(),
+            scale: None,
+        };
+        let e = World::from_requests(&models, &r.robot, &object, &r.env).unwrap_err();
+        assert_eq!(e.field, "set_object.shape.inline.data_base64");
+        assert!(e.message.contains("not base64"), "{}", e.message);
+    }
+}
