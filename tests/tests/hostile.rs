@@ -2,8 +2,8 @@
 //! built) with the real grasp planner, over a real zenoh bus on loopback: garbage
 //! payloads on every command, hostile model paths and files (FIFOs, device and
 //! procfs symlinks, a 1 GiB sparse file, 10k-deep and 100k-link URDF, NaN mesh,
-//! paths out of the roots), bad values, stop storms (alone and during a plan) and a
-//! bounded flood.
+//! paths out of the roots), inline meshes that are not base64 or not meshes,
+//! bad values, stop storms (alone and during a plan) and a bounded flood.
 //!
 //! The host runs in its own process so that an abort, a stack overflow or the OOM
 //! killer ends the child, not the test, and the test reports it (exit status and the
@@ -394,6 +394,72 @@ fn path_cases(
     cases
 }
 
+/// Inline meshes (`shape.inline`) the host must refuse without changing
+/// anything: not base64, no string, zeros, a count the bytes do not hold, an OBJ
+/// asking for a material library outside the roots, indices out of range, NaN.
+fn inline_cases(object: &serde_json::Value) -> Vec<Case> {
+    let b64 = tsukami_body::mesh_inline::encode_base64;
+    let mut lying = vec![0u8; 80];
+    lying.extend_from_slice(&u32::MAX.to_le_bytes());
+    lying.extend_from_slice(&[0u8; 50]);
+    let shapes = [
+        (
+            "not base64",
+            "stl",
+            serde_json::json!("%%%% not base64 %%%%"),
+        ),
+        ("not a string", "stl", serde_json::json!([1, 2, 3])),
+        ("zeros", "stl", b64(&vec![0u8; 700 << 10]).into()),
+        ("lying count", "stl", b64(&lying).into()),
+        (
+            "obj passwd",
+            "obj",
+            b64(b"mtllib ../../../../etc/passwd
+usemtl root
+")
+            .into(),
+        ),
+        (
+            "obj bad index",
+            "obj",
+            b64(b"v 0 0 0
+v 1 0 0
+v 0 1 0
+f 1 2 4000000000
+f -9 -8 -7
+")
+            .into(),
+        ),
+        (
+            "nan",
+            "stl",
+            b64(b"solid n
+facet normal 0 0 1
+outer loop
+vertex NaN 0 0
+vertex 1 0 0
+vertex 0 1 0
+endloop
+endfacet
+endsolid n
+")
+            .into(),
+        ),
+    ];
+    shapes
+        .into_iter()
+        .map(|(name, format, data)| {
+            let mut o = object.clone();
+            o["shape"] = serde_json::json!({"inline": {"format": format, "data_base64": data}});
+            case(
+                format!("inline {name}"),
+                planner::SET_OBJECT,
+                o.to_string().into_bytes(),
+            )
+        })
+        .collect()
+}
+
 /// The whole sequential corpus: garbage on every command, hostile paths, bad
 /// values, impossible budgets, a stop storm.
 fn corpus(robot: &serde_json::Value, object: &serde_json::Value, paths: &[String]) -> Vec<Case> {
@@ -425,6 +491,7 @@ fn corpus(robot: &serde_json::Value, object: &serde_json::Value, paths: &[String
             o.to_string().into_bytes(),
         ));
     }
+    cases.extend(inline_cases(object));
     for budget in [0u64, u64::MAX] {
         let payload = format!("{{\"max_samples\": {budget}}}").into_bytes();
         cases.push(case(
@@ -441,7 +508,10 @@ fn corpus(robot: &serde_json::Value, object: &serde_json::Value, paths: &[String
 
 /// Cases whose files must reach the parser or the size check (so the corpus
 /// keeps testing them), and what their refusal says.
-const REACHED: [(&str, &str); 6] = [
+const REACHED: [(&str, &str); 9] = [
+    ("inline not base64", "outside the alphabet"),
+    ("inline zeros", "inline STL"),
+    ("inline nan", "non-finite"),
     ("robot deep", "nested deeper than"),
     ("robot many", "more than 10000 links"),
     ("mesh nan.stl", "non-finite"),

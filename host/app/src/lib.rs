@@ -16,6 +16,7 @@
 //! - [`demo`]: `tsukami demo`, the main job.
 //! - [`scenes`]: the paper's scenes run over the bus and judged.
 //! - [`client`]: a small blocking client for the bus (CLI, demo, tests, benches).
+//! - [`inline`]: a mesh file of the client's disk sent inline in `set_object`.
 //! - [`picture`]: `tsukami view`'s and the report's pictures, drawn by `tsukami-render`.
 //!
 //! No file here imports a file that imports it back (`tests/module_cycles.rs`
@@ -26,6 +27,7 @@ pub mod client;
 pub mod config;
 pub mod demo;
 pub mod host_handle;
+pub mod inline;
 pub mod picture;
 mod reply;
 pub mod scenes;

@@ -128,12 +128,12 @@ fn by_id<'a, 'i>(doc: &'a Document<'i>, library: &str, id: &str) -> Option<Node<
         .find(|n| n.is_element() && n.attribute("id") == Some(id))
 }
 
-/// A geometry's id and its world matrix.
-type Instance = (String, Matrix4<f64>);
+/// `(geometry id, world matrix)` of each placed geometry instance.
+type Placements = Vec<(String, Matrix4<f64>)>;
 
 /// Every `(geometry id, world matrix)` of the instanced visual scene, or
 /// `None` when the file has no visual scene.
-fn instances(doc: &Document, root_matrix: Matrix4<f64>) -> Result<Option<Vec<Instance>>, String> {
+fn instances(doc: &Document, root_matrix: Matrix4<f64>) -> Result<Option<Placements>, String> {
     let root = doc.root_element();
     let url = child(root, "scene")
         .and_then(|s| child(s, "instance_visual_scene"))

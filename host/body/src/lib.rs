@@ -20,8 +20,8 @@
 //! ```
 //!
 //! Modules, lowest first: [`limits`] (parse limits, bounded reads),
-//! [`mesh`], [`mesh_clean`] and [`mesh_io`] (triangle meshes: STL, OBJ,
-//! Collada), [`packages`] (`package://` lookup), [`model`], [`urdf_xml`] and
+//! [`mesh`], [`mesh_clean`], [`mesh_io`] and [`mesh_inline`] (triangle meshes: STL, OBJ,
+//! Collada; files or base64 in a request), [`packages`] (`package://` lookup), [`model`], [`urdf_xml`] and
 //! [`urdf`] (the kinematic tree, lenient or strict), [`kinematics`] (FK, Jacobians), [`ik`],
 //! [`collision`] (with its fast narrow phase [`capsule_mesh`]; [`collision_matrix`]
 //! proposes the link pairs a robot description may leave unchecked),
@@ -40,6 +40,7 @@ pub mod kinematics;
 pub mod limits;
 pub mod mesh;
 pub mod mesh_clean;
+pub mod mesh_inline;
 pub mod mesh_inside;
 pub mod mesh_io;
 pub mod model;

@@ -3,7 +3,9 @@
 //!
 //! What: [`TriangleMesh::load`] and [`TriangleMesh::load_with`] read a mesh
 //! file, scale it, clean it ([`crate::mesh_clean`]) and refuse it only when no
-//! triangle is left; [`TriangleMesh::write_stl`] and
+//! triangle is left; [`TriangleMesh::from_bytes_with`] does the same with a
+//! file's bytes already in memory (an inline mesh, [`crate::mesh_inline`]);
+//! [`TriangleMesh::write_stl`] and
 //! [`TriangleMesh::write_obj`] write one.
 //!
 //! Why: robot collections ship STL, OBJ and Collada (about 30 % of mesh
@@ -44,10 +46,21 @@ use crate::mesh_clean::MeshCleanup;
 
 /// The mesh formats the loader reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Format {
+pub enum Format {
+    /// STL, binary or ASCII.
     Stl,
+    /// Wavefront OBJ (material libraries are not read).
     Obj,
+    /// Collada (`.dae`).
     Collada,
+}
+
+impl Format {
+    /// The format of a file, by its extension (case-insensitive), or a
+    /// message naming the extension.
+    pub fn of_path(path: &Path) -> std::result::Result<Format, String> {
+        format_of(path)
+    }
 }
 
 impl TriangleMesh {
@@ -80,8 +93,33 @@ impl TriangleMesh {
         }
         let format = format_of(path).map_err(err)?;
         let bytes = read_bounded(path, limits.max_mesh_bytes, "mesh")?;
-        let mut mesh = parse(path, &bytes, format, limits)?;
-        drop(bytes);
+        Self::from_bytes_with(&bytes, format, scale, limits, path)
+    }
+
+    /// [`TriangleMesh::load_with`] on a file's bytes already in memory (an
+    /// inline mesh of a request, [`crate::mesh_inline`]): parses `bytes` as
+    /// `format`, scales and cleans. `label` stands for the file in errors
+    /// (e.g. `inline STL`); nothing is read from or written to the disk.
+    /// Checks everything `load_with` does but the byte size, which is the
+    /// caller's (it holds the bytes already).
+    pub fn from_bytes_with(
+        bytes: &[u8],
+        format: Format,
+        scale: Vector3<f64>,
+        limits: &ParseLimits,
+        label: &Path,
+    ) -> Result<(Self, MeshCleanup)> {
+        let err = |message: String| BodyError::Mesh {
+            file: label.to_path_buf(),
+            message,
+        };
+        if !scale.iter().all(|s| s.is_finite() && *s != 0.0) {
+            return Err(err(format!(
+                "scale {:?} must be finite and non-zero",
+                scale.as_slice()
+            )));
+        }
+        let mut mesh = parse(label, bytes, format, limits)?;
         for v in &mut mesh.vertices {
             v.coords.component_mul_assign(&scale);
         }

@@ -27,6 +27,12 @@
 //! let opts: PlanOptions = serde_json::from_str(r#"{"seed": 7}"#).unwrap();
 //! assert_eq!(opts.seed, 7);
 //! assert!(serde_json::from_str::<PlanOptions>(r#"{"sed": 7}"#).is_err());
+//! // A mesh sent inline (a client on another machine): base64 of the file's bytes.
+//! let inline: SetObject = serde_json::from_str(
+//!     r#"{"shape": {"inline": {"format": "stl", "data_base64": "c29saWQgeAplbmRzb2xpZCB4Cg=="}},
+//!         "mass": 0.2, "pose": {"position": [0.5, 0, 1], "quaternion": [0, 0, 0, 1]}}"#,
+//! ).unwrap();
+//! assert!(matches!(inline.shape, tsukami_msgs::planner::ObjectShape::Inline { .. }));
 //! ```
 
 use std::collections::BTreeMap;
@@ -111,6 +117,51 @@ pub enum ObjectShape {
         /// Model name.
         name: String,
     },
+    /// A mesh sent in the request itself, for a client whose files are not on
+    /// the host's disk (another machine, the vision PC). The decoded bytes may
+    /// be at most the host's `max_mesh_bytes` (default 64 MiB; the request
+    /// payload's `max_payload_bytes`, default 16 MiB, usually bounds it first:
+    /// base64 is 4/3 of the bytes) and hold at most 2 000 000 triangles.
+    Inline {
+        /// The file format of the decoded bytes.
+        format: MeshFormat,
+        /// The mesh file's bytes, base64 (standard alphabet, `=` padding
+        /// optional; line breaks are ignored).
+        data_base64: String,
+        /// Uniform scale applied to the mesh's coordinates (default 1; use 0.001 for millimetres).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        scale: Option<f64>,
+    },
+}
+
+/// The file format of an inline mesh ([`ObjectShape::Inline`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum MeshFormat {
+    /// STL, binary or ASCII.
+    Stl,
+    /// Wavefront OBJ (positions and faces; material libraries are not read).
+    Obj,
+}
+
+impl MeshFormat {
+    /// The format's usual file extension (`"stl"`, `"obj"`), which is also its
+    /// name on the wire.
+    pub fn extension(self) -> &'static str {
+        match self {
+            MeshFormat::Stl => "stl",
+            MeshFormat::Obj => "obj",
+        }
+    }
+
+    /// The format a file extension names (case-insensitive), if any.
+    pub fn from_extension(ext: &str) -> Option<Self> {
+        match ext.to_ascii_lowercase().as_str() {
+            "stl" => Some(MeshFormat::Stl),
+            "obj" => Some(MeshFormat::Obj),
+            _ => None,
+        }
+    }
 }
 
 /// `tsukami/planner/set_object`: the object to grasp.

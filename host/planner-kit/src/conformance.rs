@@ -186,6 +186,26 @@ fn bad_objects() -> Vec<(&'static str, String, &'static str, Option<&'static str
             Some("shape"),
         ),
         (
+            "inline mesh not base64",
+            with(
+                CAN,
+                "shape",
+                json!({"inline": {"format": "stl", "data_base64": "%%%%"}}),
+            ),
+            "invalid_value",
+            Some("shape.inline.data_base64"),
+        ),
+        (
+            "inline mesh that is no mesh",
+            with(
+                CAN,
+                "shape",
+                json!({"inline": {"format": "stl", "data_base64": "AAAAAAAAAAAAAAAA"}}),
+            ),
+            "model_error",
+            Some("shape.inline"),
+        ),
+        (
             "misspelt field",
             with(CAN, "mas", json!(1.0)),
             "invalid_request",

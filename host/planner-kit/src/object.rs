@@ -10,14 +10,18 @@
 //! Why: every planner needs the same object, checked the same way: a mass, a
 //! friction or a centre of mass out of range is `invalid_value` naming the field,
 //! a mesh that cannot be read is `model_error`, a mesh over [`MAX_TRIANGLES`] is
-//! `invalid_value` naming the count and the limit, and nothing changes on any of
+//! `invalid_value` naming the count and the limit, an inline mesh over the
+//! host's `max_mesh_bytes` or not base64 is `invalid_value` naming
+//! `shape.inline.data_base64` (and the limit), and nothing changes on any of
 //! them. A mesh that is merely untidy is never refused: zero-area triangles are
 //! dropped, open, non-manifold and inconsistently wound meshes are repaired or
 //! used with a documented fallback ([`crate::mesh_topology`]), and the reply's
 //! `warnings` say what was done.
 //!
 //! How: a model name resolves to `objects/<name>/object.toml` inside the model
-//! roots; a mesh path must lie inside them. The default centre of mass is the
+//! roots; a mesh path must lie inside them; an inline mesh (base64 in the
+//! request, [`load_inline`]) is decoded in memory within the host's
+//! `max_mesh_bytes` and never touches the disk. The default centre of mass is the
 //! centroid of the enclosed volume of a closed mesh (non-manifold ones
 //! included), the convex hull's centroid for an open one, else the box centre.
 //! The collision body is a parry mesh treated as a solid whenever the winding is
@@ -33,9 +37,11 @@ use tsukami_body::convert::to_vec;
 use tsukami_body::files::FileKind;
 use tsukami_body::limits::ParseLimits;
 use tsukami_body::mesh::TriangleMesh;
+use tsukami_body::mesh_inline::InlineError;
 use tsukami_body::mesh_inside::VertexTriangles;
+use tsukami_body::mesh_io::Format;
 use tsukami_body::object::ObjectModel;
-use tsukami_msgs::planner::{BoxFace, FaceBlock, ObjectShape, OcpBox, SetObject};
+use tsukami_msgs::planner::{BoxFace, FaceBlock, MeshFormat, ObjectShape, OcpBox, SetObject};
 
 use crate::mesh_topology::{hull_centroid, prepare, Topology};
 use crate::models::{relative_error, Models};
@@ -53,6 +59,9 @@ use crate::KitError;
 /// it is built. The host's `max_mesh_bytes` (64 MiB: 1.3M binary-STL
 /// triangles) usually bounds it first.
 pub const MAX_TRIANGLES: usize = 2_000_000;
+
+/// The display name of an inline mesh's object when the request names none.
+pub const INLINE_NAME: &str = "inline";
 
 /// Where and what an object is, beside its mesh (see [`Object::from_mesh`]).
 #[derive(Clone, Copy)]
@@ -136,6 +145,52 @@ pub fn load_mesh(
         .dropped_any()
         .then(|| format!("mesh cleaned: {}", cleanup.summary()));
     Ok((stem, mesh, note))
+}
+
+/// Decodes and loads an inline mesh of a request (`field` is the shape's,
+/// `shape.inline`): the decoded bytes within the host's `max_mesh_bytes`, at
+/// most [`MAX_TRIANGLES`], cleaned; nothing is read from or written to disk.
+/// Also returns the cleaning note for the reply, if it dropped anything.
+pub fn load_inline(
+    models: &Models,
+    format: MeshFormat,
+    data_base64: &str,
+    scale: Option<f64>,
+    field: &str,
+) -> Result<(TriangleMesh, Option<String>), KitError> {
+    let s = validate::scale(scale.unwrap_or(1.0), &format!("{field}.scale"))?;
+    let data = format!("{field}.data_base64");
+    let limits = ParseLimits {
+        max_mesh_triangles: MAX_TRIANGLES,
+        max_mesh_bytes: models.roots().limits().mesh,
+        ..ParseLimits::default()
+    };
+    let format = match format {
+        MeshFormat::Stl => Format::Stl,
+        MeshFormat::Obj => Format::Obj,
+    };
+    let (mesh, cleanup) =
+        TriangleMesh::from_base64(data_base64, format, Vector3::repeat(s), &limits).map_err(
+            |e| match e {
+                InlineError::TooLarge { .. } => KitError::invalid(
+                    &data,
+                    format!("{e} (the host's `max_mesh_bytes`); send a smaller or decimated mesh"),
+                ),
+                InlineError::Triangles(m) => KitError::invalid(
+                    &data,
+                    format!("{m} (MAX_TRIANGLES = {MAX_TRIANGLES}); decimate it"),
+                ),
+                InlineError::Empty | InlineError::NotBase64(_) => {
+                    KitError::invalid(&data, e.to_string())
+                }
+                InlineError::Mesh(m) => KitError::model(&data, m),
+            },
+        )?;
+    check_triangles(&mesh, field)?;
+    let note = cleanup
+        .dropped_any()
+        .then(|| format!("mesh cleaned: {}", cleanup.summary()));
+    Ok((mesh, note))
 }
 
 /// `invalid_value` for a mesh over [`MAX_TRIANGLES`], naming count and limit.
@@ -228,6 +283,15 @@ impl Object {
                 let (stem, mesh, note) = load_mesh(models, path, *scale, "shape.mesh")?;
                 (stem, mesh, 0.5, note)
             }
+            ObjectShape::Inline {
+                format,
+                data_base64,
+                scale,
+            } => {
+                let (mesh, note) =
+                    load_inline(models, *format, data_base64, *scale, "shape.inline")?;
+                (INLINE_NAME.to_string(), mesh, 0.5, note)
+            }
         };
         let mu = validate::friction(req.friction.unwrap_or(default_mu), "friction", limits)?;
         let (lo, hi) = mesh.aabb();
@@ -249,8 +313,11 @@ impl Object {
             com_local: com,
             max_size: limits.workspace_m,
         };
-        if matches!(req.shape, ObjectShape::Mesh { .. }) {
-            // `load_mesh` cleaned it: cleaning again would change nothing.
+        if matches!(
+            req.shape,
+            ObjectShape::Mesh { .. } | ObjectShape::Inline { .. }
+        ) {
+            // `load_mesh` / `load_inline` cleaned it: cleaning again would change nothing.
             Self::from_clean_mesh(&name, mesh, note.into_iter().collect(), &placed)
         } else {
             Self::from_mesh(&name, mesh, pose, mass, mu, com, limits.workspace_m)
@@ -386,5 +453,174 @@ impl Object {
             .max_by(|&a, &b| local[a].abs().total_cmp(&local[b].abs()))
             .unwrap_or(0);
         BoxFace::from_axis(axis, local[axis] < 0.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+    use tsukami_msgs::planner::pose_at;
+
+    fn models_dir() -> PathBuf {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models")
+    }
+
+    fn b64(bytes: &[u8]) -> String {
+        tsukami_body::mesh_inline::encode_base64(bytes)
+    }
+
+    fn inline(format: MeshFormat, data_base64: String, scale: Option<f64>) -> SetObject {
+        SetObject {
+            name: None,
+            shape: ObjectShape::Inline {
+                format,
+                data_base64,
+                scale,
+            },
+            mass: 0.15,
+            friction: None,
+            pose: pose_at([0.5, -0.25, 1.1]),
+            center_of_mass: None,
+        }
+    }
+
+    fn field_and_message(e: &KitError) -> (String, String) {
+        match e {
+            KitError::InvalidValue { field, message } | KitError::Model { field, message } => {
+                (field.clone(), message.clone())
+            }
+            other => panic!("not a field error: {other}"),
+        }
+    }
+
+    #[test]
+    fn an_inline_stl_is_the_object_its_file_is() {
+        let models = Models::new([models_dir()]);
+        let limits = Limits::default();
+        let stl = std::fs::read(models_dir().join("objects/can_350ml/can_350ml.stl")).unwrap();
+        let sent =
+            Object::build(&models, &inline(MeshFormat::Stl, b64(&stl), None), &limits).unwrap();
+        let mut by_path = inline(MeshFormat::Stl, String::new(), None);
+        by_path.shape = ObjectShape::Mesh {
+            path: "objects/can_350ml/can_350ml.stl".into(),
+            scale: None,
+        };
+        let read = Object::build(&models, &by_path, &limits).unwrap();
+        assert_eq!(sent.name, INLINE_NAME);
+        assert_eq!(sent.mesh.indices, read.mesh.indices);
+        assert_eq!(sent.mesh.vertices, read.mesh.vertices);
+        assert_eq!(sent.com_local, read.com_local);
+        assert_eq!(sent.warnings, read.warnings);
+        // Scaled as a path is: millimetres.
+        let mm: Vec<u8> = {
+            let mut m = TriangleMesh {
+                vertices: read.mesh.vertices.iter().map(|v| v * 1000.0).collect(),
+                indices: read.mesh.indices.clone(),
+            };
+            m.clean();
+            let p = std::env::temp_dir().join(format!("tsukami-kit-mm-{}.stl", std::process::id()));
+            m.write_stl(&p).unwrap();
+            let bytes = std::fs::read(&p).unwrap();
+            std::fs::remove_file(&p).ok();
+            bytes
+        };
+        let scaled = Object::build(
+            &models,
+            &inline(MeshFormat::Stl, b64(&mm), Some(1e-3)),
+            &limits,
+        )
+        .unwrap();
+        assert!((scaled.volume - read.volume).abs() < 1e-3 * read.volume);
+    }
+
+    #[test]
+    fn an_inline_obj_builds_and_keeps_its_name() {
+        let models = Models::new([models_dir()]);
+        let obj = std::fs::read(models_dir().join("objects/box/box.obj")).unwrap();
+        let mut req = inline(MeshFormat::Obj, b64(&obj), None);
+        req.name = Some("client box".into());
+        let o = Object::build(&models, &req, &Limits::default()).unwrap();
+        assert_eq!(o.name, "client box");
+        assert!(o.topology.closed && o.volume > 0.0);
+    }
+
+    #[test]
+    fn too_large_bad_and_garbage_inline_meshes_name_the_field() {
+        let stl = std::fs::read(models_dir().join("objects/can_350ml/can_350ml.stl")).unwrap();
+        let limit = stl.len() as u64 - 1;
+        let sizes = tsukami_body::files::SizeLimits {
+            mesh: limit,
+            ..Default::default()
+        };
+        let small = Models::with_limits([models_dir()], sizes);
+        let limits = Limits::default();
+        let build = |models: &Models, req: SetObject| Object::build(models, &req, &limits);
+        let e = build(&small, inline(MeshFormat::Stl, b64(&stl), None)).unwrap_err();
+        let (field, message) = field_and_message(&e);
+        assert_eq!(e.code(), tsukami_msgs::ErrorCode::InvalidValue);
+        assert_eq!(field, "shape.inline.data_base64");
+        assert!(
+            message.contains(&format!("{} bytes", stl.len()))
+                && message.contains(&format!(
+                    "limit of {}",
+                    tsukami_body::mesh_inline::size(limit)
+                ))
+                && message.contains("max_mesh_bytes"),
+            "{message}"
+        );
+        let models = Models::new([models_dir()]);
+        for (data, code, says) in [
+            ("", "invalid_value", "no data"),
+            ("%%%%", "invalid_value", "outside the alphabet at offset 0"),
+            ("QUJDR", "invalid_value", "cannot be base64"),
+            (
+                "c29saWQgeAplbmRzb2xpZCB4Cg==",
+                "model_error",
+                "no triangles",
+            ),
+            ("AAAAAAAAAAAAAAAA", "model_error", "inline STL"),
+        ] {
+            let e = build(&models, inline(MeshFormat::Stl, data.into(), None)).unwrap_err();
+            let (field, message) = field_and_message(&e);
+            assert_eq!(e.code().as_str(), code, "{data}: {e}");
+            assert_eq!(field, "shape.inline.data_base64", "{data}");
+            assert!(message.contains(says), "{data}: {message}");
+        }
+        let e = build(
+            &models,
+            inline(MeshFormat::Obj, b64(b"v 1 2\nf 9 9 9\n"), None),
+        );
+        assert_eq!(e.unwrap_err().code().as_str(), "model_error");
+        let e = build(&models, inline(MeshFormat::Stl, b64(&stl), Some(0.0))).unwrap_err();
+        assert_eq!(field_and_message(&e).0, "shape.inline.scale");
+    }
+
+    #[test]
+    fn an_inline_mesh_over_max_triangles_names_the_count_and_the_limit() {
+        // 16 MB of OBJ: one triangle more than accepted, within max_mesh_bytes.
+        let mut obj = b"v 0 0 0
+"
+        .to_vec();
+        obj.extend(
+            b"f 1 1 1
+"
+            .repeat(MAX_TRIANGLES + 1),
+        );
+        let models = Models::new([models_dir()]);
+        let e = Object::build(
+            &models,
+            &inline(MeshFormat::Obj, b64(&obj), None),
+            &Limits::default(),
+        )
+        .unwrap_err();
+        let (field, message) = field_and_message(&e);
+        assert_eq!(e.code(), tsukami_msgs::ErrorCode::InvalidValue);
+        assert_eq!(field, "shape.inline.data_base64");
+        assert!(
+            message.contains(&format!("{} triangles", MAX_TRIANGLES + 1))
+                && message.contains("MAX_TRIANGLES = 2000000"),
+            "{message}"
+        );
     }
 }

@@ -12,7 +12,8 @@
 //! `tsukami-body` (models, meshes, collision) is used here, never a planner's code.
 //!
 //! How: names resolve under `models_dir` as the planners resolve them
-//! (`robots/<name>/<name>.urdf`, `objects/<name>/object.toml`); meshes and
+//! (`robots/<name>/<name>.urdf`, `objects/<name>/object.toml`; an inline mesh
+//! is decoded in memory, `tsukami_body::mesh_inline`); meshes and
 //! primitives become one closed triangle mesh, which is both the surface the
 //! contacts are measured against and the collision body. The world frame is the
 //! robot's `base_link` frame, the frame of every message.
@@ -21,10 +22,12 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Isometry3, Point3, Vector3};
 use tsukami_body::collision::{CollisionObject, RobotCollision};
+use tsukami_body::limits::ParseLimits;
 use tsukami_body::mesh::TriangleMesh;
+use tsukami_body::mesh_io::Format;
 use tsukami_body::model::{JointId, LinkId, RobotModel};
 use tsukami_body::object::ObjectModel;
-use tsukami_msgs::planner::{ObjectShape, SetEnv, SetObject, SetRobot};
+use tsukami_msgs::planner::{MeshFormat, ObjectShape, SetEnv, SetObject, SetRobot};
 
 use crate::geometry::{build_obstacle, pose_to_isometry};
 
@@ -254,6 +257,22 @@ fn load_object(models_dir: &Path, req: &SetObject) -> Result<ObjectWorld, WorldE
                 .map_err(|e| err("set_object.shape.mesh.path", e))?;
             (path.clone(), mesh, DEFAULT_FRICTION)
         }
+        ObjectShape::Inline {
+            format,
+            data_base64,
+            scale,
+        } => {
+            let field = "set_object.shape.inline.data_base64";
+            let format = match format {
+                MeshFormat::Stl => Format::Stl,
+                MeshFormat::Obj => Format::Obj,
+            };
+            let s = Vector3::repeat(scale.unwrap_or(1.0));
+            let (mesh, _) =
+                TriangleMesh::from_base64(data_base64, format, s, &ParseLimits::default())
+                    .map_err(|e| err(field, e))?;
+            ("inline".to_owned(), mesh, DEFAULT_FRICTION)
+        }
     };
     let mu = req.friction.unwrap_or(default_mu);
     let com_local = match req.center_of_mass {
@@ -282,4 +301,36 @@ fn volume_centroid(mesh: &TriangleMesh) -> Option<Point3<f64>> {
         (v + t, m + (a.coords + b.coords + c.coords) * (t / 4.0))
     });
     (volume.abs() > 1e-15).then(|| Point3::from(moment / volume))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tsukami_body::mesh_inline::encode_base64;
+
+    #[test]
+    fn an_inline_object_is_the_object_its_model_is() {
+        let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+        let r = crate::scene_requests(&models.join("scenes/can_breast.toml")).unwrap();
+        let by_model = World::from_requests(&models, &r.robot, &r.object, &r.env).unwrap();
+        let stl = std::fs::read(models.join("objects/can_350ml/can_350ml.stl")).unwrap();
+        let mut object = r.object.clone();
+        object.shape = ObjectShape::Inline {
+            format: MeshFormat::Stl,
+            data_base64: encode_base64(&stl),
+            scale: None,
+        };
+        let inline = World::from_requests(&models, &r.robot, &object, &r.env).unwrap();
+        assert_eq!(inline.object.mesh.indices, by_model.object.mesh.indices);
+        assert_eq!(inline.object.center_of_mass, by_model.object.center_of_mass);
+        assert_eq!(inline.object.mu, by_model.object.mu);
+        object.shape = ObjectShape::Inline {
+            format: MeshFormat::Obj,
+            data_base64: "%%%%".into(),
+            scale: None,
+        };
+        let e = World::from_requests(&models, &r.robot, &object, &r.env).unwrap_err();
+        assert_eq!(e.field, "set_object.shape.inline.data_base64");
+        assert!(e.message.contains("not base64"), "{}", e.message);
+    }
 }

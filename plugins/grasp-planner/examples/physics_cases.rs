@@ -75,6 +75,8 @@ fn robot_files(urdf_or_name: &str) -> Value {
 fn object_json(req: &SetObject) -> Value {
     let (mesh, scale, friction) = match &req.shape {
         ObjectShape::Mesh { path, scale } => (PathBuf::from(path), scale.unwrap_or(1.0), None),
+        // Scene files name meshes by model or path; an inline mesh never comes from one.
+        ObjectShape::Inline { .. } => panic!("the physics cases are built from scene files"),
         ObjectShape::Model { name } => {
             let dir = models().join("objects").join(name);
             let m: toml::Value =

@@ -88,6 +88,40 @@ impl Payload {
     }
 }
 
+/// `set-object`: the request, and whether to send its mesh file inline.
+#[derive(Args, Debug)]
+struct SetObjectArgs {
+    #[command(flatten)]
+    payload: Payload,
+    /// Send the file named by `shape.mesh.path` (on this machine) inline, as
+    /// base64 in the request, for a host on another machine (`.stl`, `.obj`;
+    /// the host refuses one over its `max_mesh_bytes` or `max_payload_bytes`).
+    #[arg(long)]
+    inline: bool,
+}
+
+impl SetObjectArgs {
+    fn bytes(&self) -> Result<Vec<u8>> {
+        let bytes = self.payload.bytes()?;
+        if !self.inline {
+            return Ok(bytes);
+        }
+        let mut req: tsukami_msgs::planner::SetObject = serde_json::from_slice(&bytes)
+            .context("--inline: the payload is not a set_object request")?;
+        let max = tsukami_body::files::SizeLimits::default().mesh;
+        tsukami::inline::inline_local_mesh(&mut req, max)?;
+        let out = serde_json::to_vec(&req)?;
+        if out.len() > tsukami_bus::MAX_PAYLOAD_BYTES {
+            eprintln!(
+                "tsukami: the request is {} bytes; a host with the default max_payload_bytes ({}) refuses it",
+                out.len(),
+                tsukami_bus::MAX_PAYLOAD_BYTES
+            );
+        }
+        Ok(out)
+    }
+}
+
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Serve the configured plugins on the bus until interrupted.
@@ -104,7 +138,7 @@ enum Command {
     /// SetRobot: send the robot model and grasp-type config to the planner.
     SetRobot(Payload),
     /// SetObject: send the object to grasp.
-    SetObject(Payload),
+    SetObject(SetObjectArgs),
     /// SetEnv: add or replace environment obstacles.
     SetEnv(Payload),
     /// RemoveEnv: remove environment obstacles.
@@ -207,7 +241,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
             print_reply(client.request_key(&key, b"", cli.bus.timeout()))
         }
         Command::SetRobot(p) => planner(keys::planner::SET_ROBOT, p),
-        Command::SetObject(p) => planner(keys::planner::SET_OBJECT, p),
+        Command::SetObject(a) => send(
+            &cli.bus,
+            ROLE_GRASP_PLANNER,
+            keys::planner::SET_OBJECT,
+            &a.bytes()?,
+        ),
         Command::SetEnv(p) => planner(keys::planner::SET_ENV, p),
         Command::RemoveEnv(p) => planner(keys::planner::REMOVE_ENV, p),
         Command::Plan(p) => planner(keys::planner::PLAN, p),
