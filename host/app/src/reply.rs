@@ -70,10 +70,11 @@ pub(crate) fn check_payload(query: &Query, max_bytes: usize) -> Result<(), Error
         return Err(ErrorReply::new(
             ErrorCode::PayloadTooLarge,
             format!(
-                "payload is {} bytes; this host accepts at most {max_bytes}",
+                "payload is {} bytes; this host accepts at most {max_bytes} (limits.max_payload_bytes)",
                 payload.len()
             ),
-        ));
+        )
+        .with_details(serde_json::json!({ "limit": max_bytes })));
     }
     check_json_object(std::io::BufReader::with_capacity(
         64 * 1024,

@@ -13,7 +13,7 @@ use tsukami_body::collision::RobotCollision;
 use tsukami_body::kinematics::FkState;
 use tsukami_body::scene::Scene;
 use tsukami_grasp_planner::planner::Planner;
-use tsukami_msgs::planner::{Obstacle, PlanOptions, PlanReply, SetEnv};
+use tsukami_msgs::planner::{HoldRequest, Obstacle, PlanOptions, PlanReply, SetEnv};
 use tsukami_scenes::geometry::build_obstacle;
 use tsukami_scenes::scene_requests;
 
@@ -21,9 +21,16 @@ fn models() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
 }
 
+/// Seed 1 without the hold-margin preference: the side grasp of the can,
+/// under which the board is placed (with the preference, the planner takes a
+/// grasp whose hand is higher).
 fn plan(p: &Planner) -> Result<PlanReply, tsukami_grasp_planner::planner::PlanError> {
     let opts = PlanOptions {
         seed: 1,
+        hold: HoldRequest {
+            preferred_margin: 1.0,
+            ..HoldRequest::default()
+        },
         ..PlanOptions::default()
     };
     p.plan(&opts, &AtomicBool::new(false), &mut |_| {})
