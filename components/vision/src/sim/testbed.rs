@@ -293,7 +293,10 @@ impl Testbed {
         q: &[f64],
         rng: &mut ChaCha8Rng,
     ) -> Result<Option<(Placement, f64)>> {
-        let qo = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), rng.random_range(-3.14..3.14));
+        // Not ±π: the range is part of every seeded trial drawn so far.
+        #[allow(clippy::approx_constant)]
+        let yaw = rng.random_range(-3.14..3.14);
+        let qo = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw);
         let (rt, ro) = (
             self.footprint(&target.model, &target.pose.rotation)?,
             self.footprint(model, &qo)?,
