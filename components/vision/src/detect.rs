@@ -428,15 +428,21 @@ pub fn detect_with(
         return Ok(Outcome::Found(detection));
     }
     let whole = &clusters[best.cluster];
+    let width = crate::segment::diameter(whole);
     let c = detection.pose * template.moments.centroid;
     let reason = format!(
-        "{}; it is at ({:.3}, {:.3}, {:.3}) m in a cluster of {} points {:.3} m wide ('{}' is {:.3} m across)",
+        "{}; it is at ({:.3}, {:.3}, {:.3}) m, fitted to {} cluster of {} points {:.3} m wide ('{}' is {:.3} m across)",
         explain(&best.verdict, params.min_confidence),
         c.x,
         c.y,
         c.z,
+        if width > size + params.segment.margin {
+            "a piece of a"
+        } else {
+            "a"
+        },
         whole.len(),
-        crate::segment::diameter(whole),
+        width,
         template.name,
         size
     ) + &budget;
