@@ -14,7 +14,7 @@
 //! `/tmp/vis_clusters.png`, the clusters of the strided cloud (gap GAP m,
 //! default 0.012), and prints their sizes. `CLUTTER=1` renders the
 //! benchmark's noisy clutter (wall, floor, 1–3 distractors, σ 1–3 mm, dropout
-//! 0.5–3 %) around the target.
+//! 0.5–3 %) around the target; `OCCL=f` hides `f` of it instead of 30 %.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -39,7 +39,11 @@ fn draw(tb: &mut Testbed, target: &str, occ: Option<&str>, seed: u64) -> Trial {
     } else {
         Clutter::default()
     };
-    tb.trial_in(target, occ, 0.3, seed, &clutter).unwrap()
+    let occlusion = std::env::var("OCCL")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0.3);
+    tb.trial_in(target, occ, occlusion, seed, &clutter).unwrap()
 }
 fn main() {
     let a: Vec<String> = std::env::args().collect();

@@ -475,7 +475,7 @@ fn nothing_object_sized(
 fn explain(v: &Verdict, min_confidence: f64) -> String {
     format!(
         "best candidate's confidence {:.2} is below {:.2}: the model explains {:.0} % of its cluster's points; \
-         of the model's {} measured pixels {} agree, {} see through it, {} are hidden; resting on a plane: {}",
+         of the model's {} measured pixels {} agree, {} see through it, {} are hidden; {:.0} % of its camera-facing surface is outside the image; resting on a plane: {}",
         v.confidence,
         min_confidence,
         v.explained * 100.0,
@@ -483,6 +483,7 @@ fn explain(v: &Verdict, min_confidence: f64) -> String {
         v.supported,
         v.violations,
         v.occluded,
+        v.outside * 100.0,
         if v.resting { "yes" } else { "no" },
     )
 }
