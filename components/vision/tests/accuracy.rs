@@ -100,14 +100,17 @@ fn clutter(modes: &[usize]) -> Clutter {
 #[test]
 fn found_before_a_wall_among_distractors() {
     let (mut tb, mut det) = setup();
-    for (object, modes, seed) in [
-        ("can_350ml", &[][..], 10_100),
-        ("pet_500ml", &[1][..], 11_200),
-        ("box", &[1][..], 12_300),
-        ("box", &[2, 3][..], 12_201),
+    for (object, modes, occluder, seed) in [
+        ("can_350ml", &[][..], None, 10_100),
+        ("pet_500ml", &[1][..], None, 11_200),
+        ("box", &[1][..], None, 12_300),
+        ("box", &[2, 3][..], None, 12_201),
+        // A bottle fitted to a 2 cm scrap at the image's edge, 0.5 m off, was
+        // "confirmed" at 0.98 by the 41 pixels of it inside the image.
+        ("pet_500ml", &[][..], Some("box"), 11_316),
     ] {
         let trial = tb
-            .trial_in(object, None, 0.0, seed, &clutter(modes))
+            .trial_in(object, occluder, 0.32, seed, &clutter(modes))
             .unwrap();
         assert!(!trial.others.is_empty(), "{object} {seed}: no distractor");
         let sym = det.template(object).unwrap().symmetry.clone();
