@@ -14,7 +14,8 @@
 //! `/tmp/vis_clusters.png`, the clusters of the strided cloud (gap GAP m,
 //! default 0.012), and prints their sizes. `CLUTTER=1` renders the
 //! benchmark's noisy clutter (wall, floor, 1–3 distractors, σ 1–3 mm, dropout
-//! 0.5–3 %) around the target; `OCCL=f` hides `f` of it instead of 30 %.
+//! 0.5–3 %) around the target; `OCCL=f` hides `f` of it instead of 30 %,
+//! `MODES=i,j` keeps the target in those resting modes.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -34,6 +35,10 @@ fn draw(tb: &mut Testbed, target: &str, occ: Option<&str>, seed: u64) -> Trial {
                 .to_vec(),
             sigma: Some((0.001, 0.003)),
             dropout: Some((0.005, 0.03)),
+            modes: std::env::var("MODES")
+                .ok()
+                .map(|m| m.split(',').filter_map(|i| i.parse().ok()).collect())
+                .unwrap_or_default(),
             ..Clutter::default()
         }
     } else {
