@@ -1,6 +1,6 @@
 //! Vision accuracy and speed on simulated head-camera images (issue 12).
 //!
-//! `cargo bench -p tsukami-vision --bench vision [-- --trials N] [--seed-offset K] [--verbose]`
+//! `cargo bench -p tsukami-vision --bench vision [-- --trials N] [--seed-offset K] [--verbose] [--clutter-only]`
 //!
 //! For the 350 ml can, the PET bottle and the box: N random resting poses on
 //! the can_waist table (default 20), alone and with a second object hiding
@@ -13,6 +13,18 @@
 //! seed `1000·k + i + K` alone and `1000·k + 500 + i + K` occluded (`k` the
 //! target's row, `K` the seed offset, default 0): another `K` draws another
 //! set of poses. `--verbose` prints every trial that is not within.
+//!
+//! Clutter (issue 26), the same N per object and condition: a wall behind the
+//! table, the floor (the table's legs seen below its near edge) and 1–3
+//! distractors of other models beside or behind the target, with 1 mm noise
+//! ("wall+legs+distr"); the same with σ drawn from 1–3 mm and 0.5–3 % dropout
+//! per frame ("… noisy"); the target only lying on its side, only upside down
+//! (not the bottle), and behind an occluder hiding 0–39 % of it, each in the
+//! noisy clutter. Trial `i` of condition `c` uses seed
+//! `10000 + 1000·k + 100·c + i + K`. False positives in clutter: every object
+//! that is in neither the frame's target nor its distractors asked for in the
+//! first 10 noisy frames of each target, and frames with the wall, floor and
+//! 1–3 distractors but no target, every absent object asked for.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -20,7 +32,7 @@ use std::time::Instant;
 use tsukami_body::files::ModelRoots;
 use tsukami_vision::detect::{DetectParams, Detector, Outcome};
 use tsukami_vision::icp::IcpMode;
-use tsukami_vision::sim::testbed::{Testbed, Trial};
+use tsukami_vision::sim::testbed::{Clutter, Testbed, Trial};
 
 const CASES: [(&str, &str); 3] = [
     ("can_350ml", "box"),
@@ -125,6 +137,9 @@ fn main() {
         ..DetectParams::default()
     };
     let mut before = Detector::new(roots, before_params);
+    if args.iter().any(|a| a == "--clutter-only") {
+        return clutter_rows(&mut tb, &mut det, trials_n, seed_offset, verbose);
+    }
     let mut before_rows = Vec::new();
 
     println!("vision accuracy: {trials_n} random resting poses per object and condition (seed offset {seed_offset}), 640x480, 1 mm noise");
@@ -270,4 +285,179 @@ fn main() {
         );
     }
     println!("wrong or absent objects reported as found: {confident_wrong} of {asked}");
+    clutter_rows(&mut tb, &mut det, trials_n, seed_offset, verbose);
+}
+
+/// Every model a distractor may be.
+const POOL: [&str; 5] = ["can_350ml", "can_200ml", "pet_500ml", "box", "vase"];
+
+/// The clutter of a condition: wall, floor and 1–3 distractors; `noisy`: σ
+/// 1–3 mm and 0.5–3 % dropout drawn per frame; `modes`: the target's resting
+/// modes (indices into `resting_modes`).
+fn clutter(noisy: bool, modes: &[usize]) -> Clutter {
+    Clutter {
+        wall: true,
+        floor: true,
+        distractors: (1, 3),
+        pool: POOL.iter().map(|m| m.to_string()).collect(),
+        modes: modes.to_vec(),
+        sigma: noisy.then_some((0.001, 0.003)),
+        dropout: noisy.then_some((0.005, 0.03)),
+        hide_target: false,
+    }
+}
+
+/// The clutter conditions of a target: name, clutter, occluder.
+fn conditions(target: &str, occluder: &str) -> Vec<(String, Clutter, Option<String>)> {
+    let bottle = target.starts_with("pet");
+    let mut out = vec![
+        ("wall+legs+distr".to_string(), clutter(false, &[]), None),
+        (
+            "wall+legs+distr noisy".to_string(),
+            clutter(true, &[]),
+            None,
+        ),
+        (
+            "lying, clutter".to_string(),
+            clutter(true, if bottle { &[1] } else { &[2, 3] }),
+            None,
+        ),
+    ];
+    if !bottle {
+        out.push(("upside down, clutter".into(), clutter(true, &[1]), None));
+    }
+    out.push((
+        format!("+{occluder} 0-39%, clutter"),
+        clutter(true, &[]),
+        Some(occluder.to_string()),
+    ));
+    out
+}
+
+/// The clutter rows, their totals and the false positives in clutter.
+fn clutter_rows(tb: &mut Testbed, det: &mut Detector, n: usize, offset: u64, verbose: bool) {
+    println!("\nclutter: wall behind the table, floor and legs, 1-3 distractors of other models (noisy: sigma 1-3 mm, dropout 0.5-3 % per frame)");
+    let (mut found, mut within, mut total) = (0, 0, 0);
+    let mut all_ms = Vec::new();
+    let mut noisy_frames: Vec<(String, Trial)> = Vec::new();
+    for (k, (target, occluder)) in CASES.iter().enumerate() {
+        for (c, (name, cl, occ)) in conditions(target, occluder).into_iter().enumerate() {
+            let render_start = Instant::now();
+            let trials: Vec<Trial> = (0..n)
+                .map(|i| {
+                    let seed = 10_000 + 1000 * k as u64 + 100 * c as u64 + i as u64 + offset;
+                    let occlusion = (i * 2 % 40) as f64 / 100.0;
+                    tb.trial_in(target, occ.as_deref(), occlusion, seed, &cl)
+                        .expect("trial")
+                })
+                .collect();
+            let render_s = render_start.elapsed().as_secs_f64();
+            let mut row = run(det, target, &trials, verbose);
+            let occl = trials.iter().map(|t| t.occluded).sum::<f64>() / trials.len() as f64;
+            let distr = trials.iter().map(|t| t.others.len()).sum::<usize>() as f64 / n as f64;
+            println!(
+                "{:<10} {:<26} {:>3}/{:<2} {:>5}/{:<2} {:>6.2} mm {:>5.2} mm {:>7.2}° {:>6.2}° {:>5.0}% {:>5.1} {:>8.1} {:>8.1}   (render {:.1} s)",
+                target,
+                name,
+                row.found,
+                n,
+                row.within,
+                n,
+                pct(&mut row.pos, 0.5),
+                pct(&mut row.pos, 1.0),
+                pct(&mut row.rot, 0.5),
+                pct(&mut row.rot, 1.0),
+                occl * 100.0,
+                distr,
+                pct(&mut row.ms, 0.5),
+                pct(&mut row.ms, 0.9),
+                render_s
+            );
+            (found, within, total) = (found + row.found, within + row.within, total + n);
+            all_ms.extend(row.ms.iter().copied());
+            if c == 1 {
+                noisy_frames.extend(trials.into_iter().take(10).map(|t| (target.to_string(), t)));
+            }
+        }
+    }
+    println!(
+        "clutter total: found {found}/{total}, within 5 mm / 3° {within}/{total} ({:.1} %); detect p50 {:.1} ms, p90 {:.1} ms, max {:.1} ms",
+        100.0 * within as f64 / total as f64,
+        pct(&mut all_ms.clone(), 0.5),
+        pct(&mut all_ms.clone(), 0.9),
+        pct(&mut all_ms, 1.0)
+    );
+    clutter_false_positives(tb, det, &noisy_frames, n, offset);
+}
+
+/// Absent objects asked for, reported found, the highest confidence.
+#[derive(Default)]
+struct Tally {
+    asked: usize,
+    wrong: usize,
+    max_conf: f64,
+}
+
+/// Asks for each of `objects` in `t`, counting into `tally`.
+fn ask(det: &mut Detector, t: &Trial, objects: &[&str], tally: &mut Tally) {
+    for o in objects {
+        tally.asked += 1;
+        match det.detect(o, &t.image, &t.camera).expect("detect") {
+            Outcome::Found(d) => {
+                tally.wrong += 1;
+                tally.max_conf = tally.max_conf.max(d.confidence);
+                println!(
+                    "  {o} reported in seed {} (target {}): {:.2}",
+                    t.seed, t.target.model, d.confidence
+                );
+            }
+            Outcome::NotFound(nf) => {
+                tally.max_conf = tally.max_conf.max(nf.best.map_or(0.0, |b| b.confidence));
+            }
+        }
+    }
+}
+
+/// Objects absent from the frame asked for: in the noisy clutter frames, and
+/// in frames of the clutter without a target.
+fn clutter_false_positives(
+    tb: &mut Testbed,
+    det: &mut Detector,
+    frames: &[(String, Trial)],
+    n: usize,
+    offset: u64,
+) {
+    let absent = |t: &Trial| -> Vec<&str> {
+        CASES
+            .iter()
+            .map(|(o, _)| *o)
+            .filter(|o| t.target.model != *o && t.others.iter().all(|p| p.model != *o))
+            .collect()
+    };
+    let mut tally = Tally::default();
+    for (_, t) in frames {
+        ask(det, t, &absent(t), &mut tally);
+    }
+    let (in_frames, in_wrong) = (tally.asked, tally.wrong);
+    let empty = Clutter {
+        hide_target: true,
+        ..clutter(true, &[])
+    };
+    for i in 0..n {
+        let t = tb
+            .trial_in("can_200ml", None, 0.0, 20_000 + i as u64 + offset, &empty)
+            .expect("empty frame");
+        let objects = absent(&t);
+        ask(det, &t, &objects, &mut tally);
+    }
+    let Tally {
+        asked,
+        wrong,
+        max_conf,
+    } = tally;
+    println!(
+        "clutter, absent objects asked: {in_wrong} of {in_frames} reported in the noisy frames, {} of {} in {n} frames without a target; highest confidence {max_conf:.2}",
+        wrong - in_wrong,
+        asked - in_frames
+    );
 }

@@ -12,13 +12,44 @@
 //! writes `/tmp/vis_overlay.png`: the depth image with the true (green) and
 //! detected (red) model surfaces drawn over it. `--clusters` writes
 //! `/tmp/vis_clusters.png`, the clusters of the strided cloud (gap GAP m,
-//! default 0.012), and prints their sizes.
+//! default 0.012), and prints their sizes. `CLUTTER=1` renders the
+//! benchmark's noisy clutter (wall, floor, 1–3 distractors, σ 1–3 mm, dropout
+//! 0.5–3 %) around the target; `OCCL=f` hides `f` of it instead of 30 %,
+//! `MODES=i,j` keeps the target in those resting modes.
 
 use std::path::PathBuf;
 use std::time::Instant;
 use tsukami_body::files::ModelRoots;
 use tsukami_vision::detect::{DetectParams, Detector, Outcome};
-use tsukami_vision::sim::testbed::Testbed;
+use tsukami_vision::sim::testbed::{Clutter, Testbed, Trial};
+
+/// The trial of `seed`, in the benchmark's noisy clutter when `CLUTTER=1`.
+fn draw(tb: &mut Testbed, target: &str, occ: Option<&str>, seed: u64) -> Trial {
+    let clutter = if std::env::var("CLUTTER").is_ok_and(|v| v == "1") {
+        Clutter {
+            wall: true,
+            floor: true,
+            distractors: (1, 3),
+            pool: ["can_350ml", "can_200ml", "pet_500ml", "box", "vase"]
+                .map(String::from)
+                .to_vec(),
+            sigma: Some((0.001, 0.003)),
+            dropout: Some((0.005, 0.03)),
+            modes: std::env::var("MODES")
+                .ok()
+                .map(|m| m.split(',').filter_map(|i| i.parse().ok()).collect())
+                .unwrap_or_default(),
+            ..Clutter::default()
+        }
+    } else {
+        Clutter::default()
+    };
+    let occlusion = std::env::var("OCCL")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0.3);
+    tb.trial_in(target, occ, occlusion, seed, &clutter).unwrap()
+}
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let target = a.get(1).cloned().unwrap_or("can_350ml".into());
@@ -40,7 +71,7 @@ fn main() {
         sym.axis,
         sym.discrete.len()
     );
-    let t = tb.trial(&target, occ.as_deref(), 0.3, seed).unwrap();
+    let t = draw(&mut tb, &target, occ.as_deref(), seed);
     println!(
         "truth {:?} occl {:.2} valid px {}",
         t.truth,
@@ -157,7 +188,7 @@ fn sweep(target: &str, asked: &str, occ: Option<&str>, range: std::ops::Range<u6
     let sym = det.template(target).unwrap().symmetry.clone();
     let (mut within, mut n) = (0, 0);
     for seed in range {
-        let t = tb.trial(target, occ, 0.3, seed).unwrap();
+        let t = draw(&mut tb, target, occ, seed);
         let s = Instant::now();
         let out = det.detect(asked, &t.image, &t.camera).unwrap();
         let ms = s.elapsed().as_secs_f64() * 1e3;
@@ -195,11 +226,7 @@ fn sweep(target: &str, asked: &str, occ: Option<&str>, range: std::ops::Range<u6
     println!("within 5 mm / 3°: {within}/{n}");
 }
 
-fn overlay(
-    t: &tsukami_vision::sim::testbed::Trial,
-    pts: &[nalgebra::Point3<f64>],
-    pose: &nalgebra::Isometry3<f64>,
-) {
+fn overlay(t: &Trial, pts: &[nalgebra::Point3<f64>], pose: &nalgebra::Isometry3<f64>) {
     let (w, h) = (t.image.width(), t.image.height());
     let mut rgb = vec![0u8; (w * h * 3) as usize];
     for (i, d) in t.image.data().iter().enumerate() {
@@ -227,7 +254,7 @@ fn overlay(
 }
 
 /// Writes `/tmp/vis_clusters.png`: the off-plane clusters of the strided cloud, one colour each.
-pub fn clusters_png(t: &tsukami_vision::sim::testbed::Trial, gap: f64) {
+pub fn clusters_png(t: &Trial, gap: f64) {
     use tsukami_vision::cloud::PointCloud;
     let p = DetectParams::default();
     let cloud = PointCloud::from_depth(&t.image, &t.camera, p.stride);

@@ -168,7 +168,7 @@ impl Moments {
                 + s * s.transpose())
                 * (w / 12.0);
         }
-        if !(area > 0.0) {
+        if area.is_nan() || area <= 0.0 {
             return None;
         }
         let c = first / area;

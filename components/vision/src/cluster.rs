@@ -37,7 +37,7 @@ pub fn clusters(
 ) -> Vec<Vec<usize>> {
     let mut parent: Vec<u32> = (0..grid.len() as u32).collect();
     let gap2 = max_gap * max_gap;
-    let height = if width == 0 { 0 } else { grid.len() / width };
+    let height = grid.len().checked_div(width).unwrap_or(0);
     for v in 0..height {
         for u in 0..width {
             let i = v * width + u;

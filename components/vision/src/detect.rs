@@ -8,9 +8,10 @@
 //! measures.
 //!
 //! How: back-project every `stride`-th pixel, remove the large horizontal
-//! planes (RANSAC), cut the rest into object-sized segments
-//! ([`crate::segment`]: clusters, their pieces at a smaller gap, unions of two;
-//! no wider than the model). For each segment, start ICP from every
+//! planes (RANSAC; each a connected surface wider than the model), cut the
+//! rest into object-sized segments ([`crate::segment`]: clusters, their
+//! pieces at a smaller gap, unions of two; no wider than the model; a cluster
+//! with no object-sized piece is skipped before the clusters are counted). For each segment, start ICP from every
 //! principal-axis hypothesis ([`crate::hypotheses`]) and every resting pose
 //! of the model on the plane under it ([`crate::resting`]) with a short
 //! coarse ICP (nearest samples by the template's lookup grid), and rank each
@@ -24,9 +25,13 @@
 //! points leave free; then the full verification. The candidate with the
 //! highest confidence wins, reported in its symmetry class's canonical form.
 //! The work is bounded whatever the image holds: segments and clusters are
-//! thinned to [`DetectParams::max_segment_points`], and no more fits start once
-//! [`DetectParams::max_work`] point evaluations are spent (counted, not timed,
-//! so the answer does not depend on the machine).
+//! thinned to [`DetectParams::max_segment_points`], no more coarse fits start
+//! once [`DetectParams::max_work`] point evaluations less the fine fits' share
+//! are spent, and no more fine fits once all are (counted, not timed, so the
+//! answer does not depend on the machine). "Not found" says what was seen:
+//! when nothing is object-sized, the cluster nearest the object's size and
+//! its width against the object's; otherwise the best candidate, where it is,
+//! how wide its cluster, and why its confidence is too low.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -55,6 +60,13 @@ pub const MAX_SEGMENT_POINTS: usize = 20_000;
 /// detection in the tests' and benchmarks' 640 × 480 frames spends (measured:
 /// about 300,000).
 pub const MAX_WORK: u64 = 3_000_000;
+
+/// Default [`SegmentParams::max_clusters`]: object-sized clusters kept (the
+/// oversize ones do not count). Each costs at most about 160,000 point
+/// evaluations of coarse fits (48 starts × 250 points × 13 pairings), so the
+/// coarse share of [`MAX_WORK`] covers about 17 of them: the budget, not this
+/// count, bounds a cluttered frame, and the largest are fitted first.
+pub const MAX_CLUSTERS: usize = 24;
 
 /// Settings of the pipeline.
 #[derive(Debug, Clone, PartialEq)]
@@ -121,7 +133,7 @@ impl Default for DetectParams {
                 cluster_gap: 0.012,
                 split_gaps: vec![0.6],
                 min_points: 25,
-                max_clusters: 6,
+                max_clusters: MAX_CLUSTERS,
                 merge_pairs: true,
                 margin: 0.01,
             },
@@ -259,6 +271,8 @@ pub fn check_input(image: &DepthImage, camera: &Camera) -> Result<()> {
 struct Candidate {
     fit: IcpFit,
     verdict: Verdict,
+    /// The index of the cluster it was verified against.
+    cluster: usize,
 }
 
 /// What every stage looks at: the model, the image, its planes, the settings.
@@ -270,6 +284,8 @@ struct View<'a> {
     params: &'a DetectParams,
     /// Point evaluations spent so far (see [`DetectParams::max_work`]).
     work: std::cell::Cell<u64>,
+    /// The coarse fits stopped for the budget before every segment's were made.
+    coarse_cut: std::cell::Cell<bool>,
 }
 
 impl View<'_> {
@@ -280,17 +296,25 @@ impl View<'_> {
         spent <= self.params.max_work
     }
 
-    fn exhausted(&self) -> bool {
-        self.work.get() > self.params.max_work
+    /// Counts `points` evaluations of coarse fits; false once the budget less
+    /// the fine fits' share is spent (so the best coarse fits are always refined).
+    fn spend_coarse(&self, points: usize) -> bool {
+        let p = self.params;
+        let fine = p.fine_points * (p.fine.iterations + p.exact_iterations) + p.max_segment_points;
+        let reserve = (p.max_fine * fine) as u64;
+        let within = self.spend(points) && self.work.get() <= p.max_work.saturating_sub(reserve);
+        self.coarse_cut.set(self.coarse_cut.get() || !within);
+        within
     }
 
     /// Said in every "not found" when the budget ran out before the fits did.
     fn budget_note(&self) -> String {
-        if !self.exhausted() {
+        let exhausted = self.work.get() > self.params.max_work;
+        if !exhausted && !self.coarse_cut.get() {
             return String::new();
         }
         format!(
-            "; the work budget ran out: {} point evaluations spent, the limit is {} (max_work)",
+            "; the work budget ran out before every segment was fitted: {} point evaluations spent, the limit is {} (max_work)",
             self.work.get(),
             self.params.max_work
         )
@@ -329,13 +353,20 @@ pub fn detect_with(
     if cloud.len() < params.segment.min_points {
         return not_found("the image has (almost) no depth measurements".into(), None);
     }
-    let planes = find_planes(&cloud.points, &params.plane);
+    let size = 2.0 * template.radius;
+    // No object's own top is wider than the object: a supporting plane is.
+    let plane_params = PlaneParams {
+        min_width: params.plane.min_width.max(size + params.segment.margin),
+        ..params.plane.clone()
+    };
+    let planes = find_planes(&cloud.points, &plane_params);
     let grid = Grid {
         width: image.width(),
         stride: params.stride,
     };
-    let size = 2.0 * template.radius;
-    let (mut clusters, mut segments) = segments(&cloud, &planes, grid, size, &params.segment);
+    let cut = segments(&cloud, &planes, grid, size, &params.segment);
+    let (oversize, nearest) = (cut.oversize, cut.nearest);
+    let (mut clusters, mut segments) = (cut.clusters, cut.segments);
     thin_large(&mut clusters, &mut segments, params.max_segment_points);
     let t_segment = started.elapsed();
     let view = View {
@@ -345,6 +376,7 @@ pub fn detect_with(
         planes: &planes,
         params,
         work: std::cell::Cell::new(cloud.len() as u64),
+        coarse_cut: std::cell::Cell::new(false),
     };
     let coarse = coarse_fits(&view, &segments);
     let t_coarse = started.elapsed();
@@ -364,14 +396,23 @@ pub fn detect_with(
     );
     let budget = view.budget_note();
     let Some(best) = best else {
-        return not_found(
+        let seen = if segments.is_empty() {
+            nothing_object_sized(
+                &template.name,
+                size,
+                oversize,
+                nearest.as_ref(),
+                planes.len(),
+            )
+        } else {
             format!(
-                "no object-sized cluster above the supporting plane ({} clusters, {} planes){budget}",
+                "{} object-sized segments in {} clusters above the supporting plane, but no fit of '{}' was made",
+                segments.len(),
                 clusters.len(),
-                planes.len()
-            ),
-            None,
-        );
+                template.name
+            )
+        };
+        return not_found(seen + &budget, None);
     };
     let detection = Detection {
         object: template.name.clone(),
@@ -386,15 +427,55 @@ pub fn detect_with(
     if detection.confidence >= params.min_confidence {
         return Ok(Outcome::Found(detection));
     }
-    let reason = explain(&best.verdict, params.min_confidence) + &budget;
+    let whole = &clusters[best.cluster];
+    let width = crate::segment::diameter(whole);
+    let c = detection.pose * template.moments.centroid;
+    let reason = format!(
+        "{}; it is at ({:.3}, {:.3}, {:.3}) m, fitted to {} cluster of {} points {:.3} m wide ('{}' is {:.3} m across)",
+        explain(&best.verdict, params.min_confidence),
+        c.x,
+        c.y,
+        c.z,
+        if width > size + params.segment.margin {
+            "a piece of a"
+        } else {
+            "a"
+        },
+        whole.len(),
+        width,
+        template.name,
+        size
+    ) + &budget;
     not_found(reason, Some(detection))
+}
+
+/// "Not found" when no segment is object-sized: how many clusters were too
+/// wide, and the one nearest the object's size.
+fn nothing_object_sized(
+    object: &str,
+    size: f64,
+    oversize: usize,
+    nearest: Option<&crate::segment::Oversize>,
+    planes: usize,
+) -> String {
+    let Some(n) = nearest else {
+        return format!(
+            "nothing above the supporting plane: no cluster of points off the {planes} planes found"
+        );
+    };
+    format!(
+        "no object-sized cluster above the supporting plane: {oversize} clusters, all wider than '{object}' \
+         ({size:.3} m across); the nearest in size is {:.3} m wide ({} points, centred at ({:.3}, {:.3}, {:.3}) m); \
+         {planes} planes",
+        n.width, n.points, n.centroid.x, n.centroid.y, n.centroid.z
+    )
 }
 
 /// Why a candidate's confidence is too low, in words.
 fn explain(v: &Verdict, min_confidence: f64) -> String {
     format!(
         "best candidate's confidence {:.2} is below {:.2}: the model explains {:.0} % of its cluster's points; \
-         of the model's {} measured pixels {} agree, {} see through it, {} are hidden; resting on a plane: {}",
+         of the model's {} measured pixels {} agree, {} see through it, {} are hidden; {:.0} % of its camera-facing surface is outside the image; resting on a plane: {}",
         v.confidence,
         min_confidence,
         v.explained * 100.0,
@@ -402,6 +483,7 @@ fn explain(v: &Verdict, min_confidence: f64) -> String {
         v.supported,
         v.violations,
         v.occluded,
+        v.outside * 100.0,
         if v.resting { "yes" } else { "no" },
     )
 }
@@ -414,7 +496,7 @@ fn coarse_fits(view: &View, segments: &[Segment]) -> Vec<Hypothesis> {
     let cam = view.camera.centre();
     let mut all: Vec<Hypothesis> = Vec::new();
     for (si, seg) in segments.iter().enumerate() {
-        if view.exhausted() {
+        if !view.spend_coarse(0) {
             break;
         }
         let Some(m) = Moments::of(&seg.points) else {
@@ -430,7 +512,7 @@ fn coarse_fits(view: &View, segments: &[Segment]) -> Vec<Hypothesis> {
         let cost = pts.len() * (params.coarse.iterations + 1);
         let mut fits: Vec<Hypothesis> = starts
             .into_iter()
-            .take_while(|_| view.spend(cost))
+            .take_while(|_| view.spend_coarse(cost))
             .map(|start| {
                 let fit = refine(template, &pts, Some(cam), start, &params.coarse);
                 Hypothesis {
@@ -482,7 +564,8 @@ fn best_fine(
         if !view.spend(cost) {
             break;
         }
-        let cand = fine_fit(view, &seg.points, &clusters[seg.parent], h.fit.pose);
+        let mut cand = fine_fit(view, &seg.points, &clusters[seg.parent], h.fit.pose);
+        cand.cluster = seg.parent;
         if best
             .as_ref()
             .is_none_or(|b| cand.verdict.confidence > b.verdict.confidence)
@@ -550,7 +633,11 @@ fn fine_fit(
     if params.require_support && !verdict.resting {
         verdict.confidence = 0.0;
     }
-    Candidate { fit, verdict }
+    Candidate {
+        fit,
+        verdict,
+        cluster: 0,
+    }
 }
 
 /// The gap between the model at `pose` and the nearest plane below its

@@ -233,7 +233,7 @@ mod tests {
         assert!(dp < 1e-12 && da < 1e-9);
         // The canonical pose of an upside-down box is upright.
         let up = sym.canonical(
-            &(truth * rotation_about(&c, &Vector3::x_axis(), 3.14159265)),
+            &(truth * rotation_about(&c, &Vector3::x_axis(), std::f64::consts::PI)),
             &Vector3::x(),
         );
         assert!((up.rotation * Vector3::z()).z > 0.999);

@@ -28,7 +28,11 @@
 //!   supported, more than `max_seen_through` of it is seen through (a wrong
 //!   model sticking out of the object: on the benchmark's images right poses
 //!   see through at most 1.7 % of their judged pixels, a bottle fitted to a
-//!   lying can 13 % or more) or more than `max_occluded` of it is hidden.
+//!   lying can 13 % or more), more than `max_occluded` of it is hidden, or
+//!   more than `max_outside` of its camera-facing samples fall outside the
+//!   image (a model mostly out of the frame cannot be judged: a bottle fitted
+//!   to a 2 cm scrap at the image's edge was "confirmed" by the 41 pixels of
+//!   it left inside).
 
 use nalgebra::{Isometry3, Point3};
 
@@ -60,6 +64,8 @@ pub struct VerifyParams {
     /// Model samples seen at a larger angle between the view ray and their
     /// normal are not judged (rad).
     pub max_incidence: f64,
+    /// Largest fraction of the model's camera-facing samples outside the image.
+    pub max_outside: f64,
     /// Judge every `sample_step`-th model sample only (1: all; a quick
     /// score for ranking hypotheses uses more).
     pub sample_step: usize,
@@ -78,6 +84,7 @@ impl Default for VerifyParams {
             max_occluded: 0.6,
             max_seen_through: 0.06,
             unmeasured_weight: 0.5,
+            max_outside: 0.5,
             max_incidence: 75f64.to_radians(),
             sample_step: 1,
             fast_pairing: false,
@@ -100,6 +107,8 @@ pub struct Verdict {
     pub near_misses: usize,
     /// Model pixels without a measurement.
     pub unmeasured: usize,
+    /// Fraction of the model's camera-facing samples outside the image.
+    pub outside: f64,
     /// The model rests on a plane found in the image (set by the detector).
     pub resting: bool,
     /// The combined confidence in [0, 1].
@@ -177,31 +186,35 @@ fn explained_fraction(
 }
 
 /// The camera-facing model samples at `pose` as a z-buffer: (pixel index,
-/// optical depth), sorted by pixel, the nearest per pixel.
+/// optical depth), sorted by pixel, the nearest per pixel; and the fraction
+/// of those samples outside the image.
 fn splat(
     template: &ObjectTemplate,
     pose: &Isometry3<f64>,
     camera: &Camera,
     params: &VerifyParams,
-) -> Vec<(u32, f64)> {
+) -> (Vec<(u32, f64)>, f64) {
     let cam_obj = pose.inverse() * camera.centre();
     let to_cam = camera.pose.inverse() * pose;
     let mut splats: Vec<(u32, f64)> = Vec::new();
     let cos_max = params.max_incidence.cos();
     let step = params.sample_step.max(1);
+    let (mut facing, mut outside) = (0usize, 0usize);
     for (p, n) in template.points.iter().zip(&template.normals).step_by(step) {
         let ray = cam_obj - p;
         if n.dot(&ray) <= cos_max * ray.norm() {
             continue;
         }
         let pc = to_cam * p;
-        if let Some((u, v)) = camera.intrinsics.pixel_of(&pc) {
-            splats.push((v * camera.intrinsics.width + u, pc.z));
+        facing += 1;
+        match camera.intrinsics.pixel_of(&pc) {
+            Some((u, v)) => splats.push((v * camera.intrinsics.width + u, pc.z)),
+            None => outside += 1,
         }
     }
     splats.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     splats.dedup_by_key(|s| s.0);
-    splats
+    (splats, outside as f64 / facing.max(1) as f64)
 }
 
 /// The model's pixels at `pose` sorted by what the image measured there
@@ -213,12 +226,11 @@ pub fn pixel_counts(
     camera: &Camera,
     params: &VerifyParams,
 ) -> Verdict {
-    count_pixels(
-        &splat(template, pose, camera, params),
-        image,
-        camera,
-        params,
-    )
+    let (splats, outside) = splat(template, pose, camera, params);
+    Verdict {
+        outside,
+        ..count_pixels(&splats, image, camera, params)
+    }
 }
 
 fn count_pixels(
@@ -251,15 +263,17 @@ pub fn verify(
     camera: &Camera,
     params: &VerifyParams,
 ) -> Verdict {
-    let splats = splat(template, pose, camera, params);
+    let (splats, outside) = splat(template, pose, camera, params);
     let inv = pose.inverse();
     let mut verdict = count_pixels(&splats, image, camera, params);
+    verdict.outside = outside;
     verdict.explained = explained_fraction(template, &inv, segment, camera, &splats, params);
     let explained = verdict.explained;
     let supported = verdict.agreement(params.unmeasured_weight);
     verdict.confidence = if supported >= params.min_visible
         && verdict.seen_through() <= params.max_seen_through
         && verdict.occluded_fraction() <= params.max_occluded
+        && verdict.outside <= params.max_outside
     {
         explained * supported
     } else {

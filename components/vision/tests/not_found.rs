@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use nalgebra::Point3;
 use tsukami_body::files::ModelRoots;
 use tsukami_vision::detect::{DetectParams, Detector, Outcome};
-use tsukami_vision::sim::testbed::Testbed;
+use tsukami_vision::sim::testbed::{Clutter, Testbed};
 
 fn setup() -> (Testbed, Detector) {
     let m = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models");
@@ -58,6 +58,61 @@ fn wrong_object() {
                 }
             }
             Outcome::Found(d) => panic!("{asked} reported in an image of {shown}: {d:?}"),
+        }
+    }
+}
+
+/// A wall behind the table and the floor, nothing on the table: not found,
+/// and the message says how wide what it saw is against the object — the
+/// nearest-sized cluster when nothing is object-sized, else the cluster the
+/// best candidate was fitted to (here a piece of the wall or the floor).
+#[test]
+fn only_a_wall_says_how_wide_what_it_saw_is() {
+    let (mut tb, mut det) = setup();
+    let scene = Clutter {
+        wall: true,
+        floor: true,
+        hide_target: true,
+        ..Clutter::default()
+    };
+    let trial = tb.trial_in("can_350ml", None, 0.0, 5, &scene).unwrap();
+    match det
+        .detect("can_350ml", &trial.image, &trial.camera)
+        .unwrap()
+    {
+        Outcome::NotFound(n) => {
+            let r = &n.reason;
+            let nothing =
+                r.contains("no object-sized cluster") && r.contains("the nearest in size is");
+            let piece = r.contains("fitted to a piece of a cluster");
+            assert!(nothing || piece, "{r}");
+            assert!(r.contains("m wide") && r.contains("0.134 m across"), "{r}");
+        }
+        Outcome::Found(d) => panic!("a can found on an empty table before a wall: {d:?}"),
+    }
+}
+
+/// Absent objects asked for among a wall, the legs and distractors.
+#[test]
+fn absent_objects_among_distractors() {
+    let (mut tb, mut det) = setup();
+    let scene = Clutter {
+        wall: true,
+        floor: true,
+        distractors: (2, 3),
+        pool: ["can_200ml", "vase", "pet_500ml"]
+            .map(String::from)
+            .to_vec(),
+        hide_target: true,
+        ..Clutter::default()
+    };
+    for seed in [20_000, 20_001] {
+        let trial = tb.trial_in("can_200ml", None, 0.0, seed, &scene).unwrap();
+        for object in ["can_350ml", "box"] {
+            match det.detect(object, &trial.image, &trial.camera).unwrap() {
+                Outcome::NotFound(n) => assert!(!n.reason.is_empty()),
+                Outcome::Found(d) => panic!("{object} reported among distractors ({seed}): {d:?}"),
+            }
         }
     }
 }

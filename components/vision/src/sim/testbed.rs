@@ -19,6 +19,16 @@
 //! finds the requested occluded fraction, measured by ray casting labels
 //! (the target's pixels with and without the occluder). Everything is drawn
 //! from a ChaCha stream seeded by the trial's seed.
+//!
+//! Clutter ([`Clutter`], [`Testbed::trial_in`]; issue 26): a wall 0–6 cm
+//! behind the table's far edge; the floor, so the table's legs and the floor
+//! show below the table's near edge; distractors (other models at random
+//! resting poses on the table, 3 cm or more from the target and each other,
+//! beside or behind the target as seen from the camera, never in front of
+//! it); the target in chosen resting modes only (lying, upside down); the
+//! noise's σ and dropout drawn per trial from ranges; or the target left out
+//! (a frame with everything but the target, for false positives). The default
+//! clutter draws nothing more, so [`Testbed::trial`] renders what it always did.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -44,6 +54,27 @@ pub struct Placement {
     pub model: String,
     /// Pose of the object frame in the world.
     pub pose: Isometry3<f64>,
+}
+
+/// What else a trial shows besides the target and its occluder.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Clutter {
+    /// A wall behind the table (0–6 cm behind its far edge, drawn).
+    pub wall: bool,
+    /// The floor: the table's legs and the floor show below its near edge.
+    pub floor: bool,
+    /// Fewest and most distractors (drawn uniformly between).
+    pub distractors: (usize, usize),
+    /// Distractor models (the target's own model is never one).
+    pub pool: Vec<String>,
+    /// The target's resting modes, indices into [`resting_modes`] (empty: all).
+    pub modes: Vec<usize>,
+    /// Range of the depth noise's σ (m), drawn per trial (none: the testbed's).
+    pub sigma: Option<(f64, f64)>,
+    /// Range of the dropout probability, drawn per trial (none: the testbed's).
+    pub dropout: Option<(f64, f64)>,
+    /// Leave the target out of the image (it still chooses where the camera looks).
+    pub hide_target: bool,
 }
 
 /// One rendered trial.
@@ -90,6 +121,8 @@ pub struct Testbed {
     pub noise: NoiseModel,
     objects_dir: std::path::PathBuf,
     models: HashMap<String, ObjectModel>,
+    /// Obstacles of the current trial's clutter (wall, floor).
+    extra: Vec<tsukami_body::collision::CollisionObject>,
 }
 
 impl Testbed {
@@ -133,6 +166,7 @@ impl Testbed {
             noise: NoiseModel::default(),
             objects_dir: objects_dir.to_path_buf(),
             models: HashMap::new(),
+            extra: Vec::new(),
         })
     }
 
@@ -174,7 +208,29 @@ impl Testbed {
 
     /// A random resting pose of `model` on the table, drawn from `rng`.
     pub fn random_rest(&mut self, model: &str, rng: &mut ChaCha8Rng) -> Result<Placement> {
-        let modes = resting_modes(model);
+        self.random_rest_in(model, &[], rng)
+    }
+
+    /// [`Testbed::random_rest`] in one of the resting modes `only` (indices
+    /// into [`resting_modes`]; empty: any).
+    pub fn random_rest_in(
+        &mut self,
+        model: &str,
+        only: &[usize],
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Placement> {
+        let all = resting_modes(model);
+        let modes: Vec<UnitQuaternion<f64>> = if only.is_empty() {
+            all
+        } else {
+            only.iter().filter_map(|&i| all.get(i).copied()).collect()
+        };
+        if modes.is_empty() {
+            return Err(invalid(
+                "modes",
+                format!("'{model}' has no resting mode {only:?}"),
+            ));
+        }
         let mode = modes[rng.random_range(0..modes.len())];
         let yaw = rng.random_range(-std::f64::consts::PI..std::f64::consts::PI);
         let q = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw) * mode;
@@ -195,7 +251,7 @@ impl Testbed {
     /// The renderable world: obstacles, the robot at `q`, and `placements`.
     pub fn world(&mut self, placements: &[Placement], q: &[f64]) -> Result<SimWorld> {
         let mut w = SimWorld::default();
-        for o in &self.scene.obstacles {
+        for o in self.scene.obstacles.iter().chain(&self.extra) {
             w.add_object(o);
         }
         let cam_world = self.scene.robot_base * self.head.pose(q);
@@ -247,15 +303,87 @@ impl Testbed {
         occlusion: f64,
         seed: u64,
     ) -> Result<Trial> {
+        self.trial_in(target, occluder, occlusion, seed, &Clutter::default())
+    }
+
+    /// [`Testbed::trial`] with `clutter` around the target.
+    pub fn trial_in(
+        &mut self,
+        target: &str,
+        occluder: Option<&str>,
+        occlusion: f64,
+        seed: u64,
+        clutter: &Clutter,
+    ) -> Result<Trial> {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        self.extra = self.clutter_obstacles(clutter, &mut rng)?;
+        let noise = self.noise.clone();
+        if let Some((lo, hi)) = clutter.sigma {
+            self.noise.sigma = rng.random_range(lo..=hi);
+        }
+        if let Some((lo, hi)) = clutter.dropout {
+            self.noise.dropout = rng.random_range(lo..=hi);
+        }
+        let trial = self.draw_trial(target, occluder, occlusion, seed, clutter, &mut rng);
+        self.noise = noise;
+        trial
+    }
+
+    /// The wall and the floor of `clutter`.
+    fn clutter_obstacles(
+        &self,
+        clutter: &Clutter,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Vec<tsukami_body::collision::CollisionObject>> {
+        use tsukami_body::collision::{CollisionObject, Part};
+        use tsukami_body::model::Geometry;
+        let slab = |name: &str, centre: Vector3<f64>, size: Vector3<f64>| -> Result<_> {
+            let part = Part::from_geometry(&Isometry3::identity(), &Geometry::Box { size })?;
+            Ok(CollisionObject::new(
+                name,
+                Isometry3::from_parts(Translation3::from(centre), UnitQuaternion::identity()),
+                vec![part],
+            ))
+        };
+        let t = self.table;
+        let mut out = Vec::new();
+        if clutter.wall {
+            let x = t.x.1 + rng.random_range(0.0..0.06) + 0.025;
+            let y = 0.5 * (t.y.0 + t.y.1);
+            out.push(slab(
+                "wall",
+                Vector3::new(x, y, 0.9),
+                Vector3::new(0.05, 3.0, 1.8),
+            )?);
+        }
+        if clutter.floor {
+            out.push(slab(
+                "floor",
+                Vector3::new(1.0, 0.0, -0.01),
+                Vector3::new(4.0, 4.0, 0.02),
+            )?);
+        }
+        Ok(out)
+    }
+
+    /// The trial's placements and image (see [`Testbed::trial_in`]).
+    fn draw_trial(
+        &mut self,
+        target: &str,
+        occluder: Option<&str>,
+        occlusion: f64,
+        seed: u64,
+        clutter: &Clutter,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Trial> {
         for _ in 0..50 {
-            let placement = self.random_rest(target, &mut rng)?;
+            let placement = self.random_rest_in(target, &clutter.modes, rng)?;
             let centroid = placement.pose * centre_of(self.model(target)?);
             let q = self.look_at(&centroid);
             let mut others = Vec::new();
             let mut occluded = 0.0;
             if let Some(occ) = occluder {
-                match self.place_occluder(&placement, occ, occlusion, &q, &mut rng)? {
+                match self.place_occluder(&placement, occ, occlusion, &q, rng)? {
                     Some((p, f)) => {
                         others.push(p);
                         occluded = f;
@@ -265,6 +393,12 @@ impl Testbed {
             }
             let mut all = vec![placement.clone()];
             all.extend(others.iter().cloned());
+            let extra = self.distractors(&all, clutter, &q, rng)?;
+            others.extend(extra.iter().cloned());
+            all.extend(extra);
+            if clutter.hide_target {
+                all.remove(0);
+            }
             let (image, camera) = self.render(&all, &q, rng.random())?;
             return Ok(Trial {
                 seed,
@@ -283,6 +417,88 @@ impl Testbed {
         })
     }
 
+    /// Distractors for `clutter` beside or behind `placed[0]` (the target),
+    /// clear of everything in `placed` and of each other.
+    fn distractors(
+        &mut self,
+        placed: &[Placement],
+        clutter: &Clutter,
+        q: &[f64],
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Vec<Placement>> {
+        let (lo, hi) = clutter.distractors;
+        let pool: Vec<String> = clutter
+            .pool
+            .iter()
+            .filter(|m| **m != placed[0].model)
+            .cloned()
+            .collect();
+        if hi == 0 || pool.is_empty() {
+            return Ok(Vec::new());
+        }
+        let count = rng.random_range(lo..=hi.max(lo));
+        let cam = (self.scene.robot_base * self.head.pose(q))
+            .translation
+            .vector
+            .xy();
+        let mut taken: Vec<(Vector2<f64>, f64)> = Vec::new();
+        for p in placed {
+            taken.push((
+                self.centre_xy(p)?,
+                self.footprint(&p.model, &p.pose.rotation)?,
+            ));
+        }
+        let (target, rt) = taken[0];
+        let d = (target - cam).normalize();
+        let mut out = Vec::new();
+        for _ in 0..count {
+            let model = pool[rng.random_range(0..pool.len())].clone();
+            for _ in 0..30 {
+                let p = self.random_rest_on_table(&model, rng)?;
+                let (c, r) = (
+                    self.centre_xy(&p)?,
+                    self.footprint(&model, &p.pose.rotation)?,
+                );
+                let clear = taken.iter().all(|(o, ro)| (c - o).norm() > r + ro + 0.03);
+                // Not in front: behind the target's front, or off its line of sight.
+                let rel = c - target;
+                let beside = (rel - d * rel.dot(&d)).norm() > rt + r + 0.03;
+                if clear && (rel.dot(&d) > -rt || beside) {
+                    taken.push((c, r));
+                    out.push(p);
+                    break;
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// A random resting pose of `model` anywhere on the table top (5 cm from its edges).
+    fn random_rest_on_table(&mut self, model: &str, rng: &mut ChaCha8Rng) -> Result<Placement> {
+        let modes = resting_modes(model);
+        let mode = modes[rng.random_range(0..modes.len())];
+        let yaw = rng.random_range(-std::f64::consts::PI..std::f64::consts::PI);
+        let q = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw) * mode;
+        let r = self.footprint(model, &q)?;
+        let t = self.table;
+        let (xlo, xhi) = (t.x.0 + 0.05 + r, t.x.1 - 0.05 - r);
+        let (ylo, yhi) = (t.y.0 + 0.05 + r, t.y.1 - 0.05 - r);
+        if xlo >= xhi || ylo >= yhi {
+            return Err(invalid(
+                "table",
+                format!("the table top is too small for '{model}'"),
+            ));
+        }
+        let xy = Vector2::new(rng.random_range(xlo..xhi), rng.random_range(ylo..yhi));
+        self.rest(model, q, xy)
+    }
+
+    /// The centre of a placement's footprint (world xy).
+    fn centre_xy(&mut self, p: &Placement) -> Result<Vector2<f64>> {
+        let (lo, hi) = rotated_box(self.model(&p.model)?, &p.pose.rotation);
+        Ok(p.pose.translation.vector.xy() + (lo.xy() + hi.xy()) * 0.5)
+    }
+
     /// Places `model` upright between the camera and `target` so that about
     /// `fraction` of the target's pixels are hidden; `None` if it does not fit.
     fn place_occluder(
@@ -293,7 +509,10 @@ impl Testbed {
         q: &[f64],
         rng: &mut ChaCha8Rng,
     ) -> Result<Option<(Placement, f64)>> {
-        let qo = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), rng.random_range(-3.14..3.14));
+        // Not ±π: the range is part of every seeded trial drawn so far.
+        #[allow(clippy::approx_constant)]
+        let yaw = rng.random_range(-3.14..3.14);
+        let qo = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw);
         let (rt, ro) = (
             self.footprint(&target.model, &target.pose.rotation)?,
             self.footprint(model, &qo)?,
