@@ -120,6 +120,19 @@ impl Default for PlaneParams {
     }
 }
 
+/// Two unit axes spanning the plane of unit normal `n` (`e1`, `e2`, with
+/// `e1 × e2 = n`): the world x (or y, when `n` is close to x) projected on
+/// it, and the third.
+pub fn in_plane_axes(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let any = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let e1 = (any - n * n.dot(&any)).normalize();
+    (e1, n.cross(&e1))
+}
+
 /// The large horizontal planes of `points`, biggest first, each a connected
 /// surface (see the module's How).
 pub fn find_planes(points: &[Point3<f64>], params: &PlaneParams) -> Vec<FoundPlane> {
@@ -175,14 +188,7 @@ fn surfaces(
     if inliers.len() < min_count {
         return Vec::new();
     }
-    let n = plane.normal.into_inner();
-    let any = if n.x.abs() < 0.9 {
-        Vector3::x()
-    } else {
-        Vector3::y()
-    };
-    let e1 = (any - n * n.dot(&any)).normalize();
-    let e2 = n.cross(&e1);
+    let (e1, e2) = in_plane_axes(&plane.normal);
     let uv: Vec<(f64, f64)> = inliers
         .iter()
         .map(|&i| (points[i].coords.dot(&e1), points[i].coords.dot(&e2)))

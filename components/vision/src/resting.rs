@@ -30,20 +30,14 @@
 use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, UnitQuaternion, Vector3};
 
 use crate::hypotheses::{place, push_distinct};
-use crate::plane::Plane;
+use crate::plane::{in_plane_axes, Plane};
 use crate::template::ObjectTemplate;
 
 /// The principal direction of `points` projected on the plane of normal `n`
 /// (unit, horizontal; any horizontal direction for fewer than 2 points).
 pub fn horizontal_direction(points: &[Point3<f64>], n: &Vector3<f64>) -> Vector3<f64> {
     let n = n.normalize();
-    let any = if n.x.abs() < 0.9 {
-        Vector3::x()
-    } else {
-        Vector3::y()
-    };
-    let e1 = (any - n * n.dot(&any)).normalize();
-    let e2 = n.cross(&e1);
+    let (e1, e2) = in_plane_axes(&n);
     if points.len() < 2 {
         return e1;
     }

@@ -5,8 +5,8 @@
 use std::path::PathBuf;
 
 use tsukami_body::files::ModelRoots;
-use tsukami_vision::detect::{DetectParams, Detector, Outcome};
-use tsukami_vision::sim::testbed::{Clutter, Testbed};
+use tsukami_vision::detect::{DetectParams, Detection, Detector, Outcome};
+use tsukami_vision::sim::testbed::{Clutter, Testbed, Trial};
 
 fn models() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models")
@@ -33,6 +33,12 @@ fn check(tb: &mut Testbed, det: &mut Detector, object: &str, occluder: Option<&s
             trial.occluded
         );
     }
+    let d = found_within(det, object, seed, &trial);
+    assert!(d.confidence >= 0.8 && d.rms < 0.002, "{d:?}");
+}
+
+/// The detection of `object` in `trial`, asserted found within 5 mm / 3°.
+fn found_within(det: &mut Detector, object: &str, seed: u64, trial: &Trial) -> Detection {
     let sym = det.template(object).unwrap().symmetry.clone();
     match det.detect(object, &trial.image, &trial.camera).unwrap() {
         Outcome::Found(d) => {
@@ -43,7 +49,7 @@ fn check(tb: &mut Testbed, det: &mut Detector, object: &str, occluder: Option<&s
                 dp * 1e3,
                 da.to_degrees()
             );
-            assert!(d.confidence >= 0.8 && d.rms < 0.002, "{d:?}");
+            d
         }
         Outcome::NotFound(n) => panic!("{object} seed {seed} not found: {}", n.reason),
     }
@@ -113,19 +119,7 @@ fn found_before_a_wall_among_distractors() {
             .trial_in(object, occluder, 0.32, seed, &clutter(modes))
             .unwrap();
         assert!(!trial.others.is_empty(), "{object} {seed}: no distractor");
-        let sym = det.template(object).unwrap().symmetry.clone();
-        match det.detect(object, &trial.image, &trial.camera).unwrap() {
-            Outcome::Found(d) => {
-                let (dp, da) = sym.pose_error(&d.pose, &trial.truth);
-                assert!(
-                    dp < 0.005 && da.to_degrees() < 3.0,
-                    "{object} seed {seed}: error {:.2} mm {:.2}°",
-                    dp * 1e3,
-                    da.to_degrees()
-                );
-            }
-            Outcome::NotFound(n) => panic!("{object} seed {seed} not found: {}", n.reason),
-        }
+        found_within(&mut det, object, seed, &trial);
     }
 }
 
