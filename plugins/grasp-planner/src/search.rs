@@ -171,8 +171,8 @@ pub struct Judged {
 pub enum Outcome {
     /// A grasp was found.
     Found(Box<Found>),
-    /// The samples ran out with accepted grasps that some object pose error
-    /// drops: the one that held under the most.
+    /// The samples ran out with accepted grasps none of which is preferred
+    /// ([`Found::preferred`]): the best ranked ([`Found::rank`]).
     Partial(Box<Found>),
     /// All samples were used.
     Exhausted,
@@ -183,7 +183,7 @@ pub enum Outcome {
 }
 
 /// The reasons a sample is rejected, in the order of [`Counters::rejections`].
-pub const REJECTION_REASONS: [&str; 10] = [
+pub const REJECTION_REASONS: [&str; 11] = [
     "ik",
     "collision before closing",
     "finger closing",
@@ -194,6 +194,7 @@ pub const REJECTION_REASONS: [&str; 10] = [
     "pose error",
     "too compliant",
     "motion blocked",
+    "below preferred margin",
 ];
 
 /// Samples a search goes on drawing, after its first accepted grasp that is
@@ -212,7 +213,7 @@ pub struct Counters {
     /// Best ellipsoid margin seen.
     pub best_margin: Option<f64>,
     /// Why samples were rejected, per [`REJECTION_REASONS`].
-    pub rejections: [u32; 10],
+    pub rejections: [u32; 11],
     /// What blocked the collision-rejected samples: `"<link> vs <obstacle>"`
     /// (or `"… vs <link>"` for self-collision) with counts.
     pub blockers: BTreeMap<String, u32>,
@@ -297,7 +298,8 @@ pub fn search(
             if found.preferred(preferred) {
                 return Some(Outcome::Found(found));
             }
-            counters.reject(7, None);
+            let held_all = found.robustness.held == found.robustness.samples;
+            counters.reject(if held_all { 10 } else { 7 }, None);
             if best.is_none() {
                 stop_at.set(at.saturating_add(ROBUST_EXTRA_SAMPLES));
             }
