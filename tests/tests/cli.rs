@@ -59,6 +59,55 @@ fn plugins_lists_what_a_running_host_serves() {
     assert!(stderr.contains("no_plugin"), "{stderr}");
 }
 
+/// `tsukami <command>` against `endpoint`/`namespace` with `extra` arguments.
+fn cli(endpoint: &str, namespace: &str, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(tsukami_exe())
+        .args(args)
+        .args(["--connect", endpoint, "--namespace", namespace])
+        .output()
+        .unwrap()
+}
+
+/// A CLI timeout says whether a host is there: the vase on the table takes the
+/// planner seconds (sample-bounded work; 3.4 s over the bus on the 2-core
+/// machine), so a 200 ms `--timeout-ms` expires while the host works, and the
+/// CLI says the host is running; with no host on the bus it says so instead.
+#[test]
+fn a_cli_timeout_says_whether_a_host_is_there() {
+    let port = free_loopback_port().unwrap();
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let namespace = format!("cli-timeout-{port}");
+    let missing = cli(&endpoint, &namespace, &["stop", "--timeout-ms", "300"]);
+    let stderr = String::from_utf8_lossy(&missing.stderr);
+    assert!(!missing.status.success());
+    assert!(stderr.contains("no host answered on"), "{stderr}");
+
+    let _host = spawn_tsukami(&["run", "--listen", &endpoint, "--namespace", &namespace]);
+    cli_plugins_listing(&endpoint, &namespace);
+    let req = scene_requests(&models_dir().join("scenes/vase_table.toml")).unwrap();
+    for (command, body) in [
+        ("set-robot", serde_json::to_string(&req.robot).unwrap()),
+        ("set-object", serde_json::to_string(&req.object).unwrap()),
+        ("set-env", serde_json::to_string(&req.env).unwrap()),
+    ] {
+        let out = cli(&endpoint, &namespace, &[command, &body]);
+        assert!(
+            out.status.success(),
+            "{command}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let slow = cli(
+        &endpoint,
+        &namespace,
+        &["plan", "{\"seed\": 0}", "--timeout-ms", "200"],
+    );
+    let stderr = String::from_utf8_lossy(&slow.stderr);
+    assert!(!slow.status.success());
+    assert!(stderr.contains("is running but did not answer"), "{stderr}");
+    assert!(stderr.contains("--timeout-ms"), "{stderr}");
+}
+
 #[test]
 fn view_draws_a_scene_headless_and_names_bad_arguments() {
     let dir = std::env::temp_dir().join(format!("tsukami-view-{}", std::process::id()));

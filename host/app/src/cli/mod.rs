@@ -312,7 +312,35 @@ fn route(listen: &str, bus: &BusArgs) -> Result<ExitCode> {
 
 fn send(bus: &BusArgs, role: &str, command: &str, payload: &[u8]) -> Result<ExitCode> {
     let client = BusClient::connect(&bus.client_bus(), &bus.namespace)?;
-    print_reply(client.command(role, command, payload, bus.timeout()))
+    match client.command(role, command, payload, bus.timeout()) {
+        Err(RequestError::Timeout { key, timeout }) => Err(timed_out(&client, bus, &key, timeout)),
+        reply => print_reply(reply),
+    }
+}
+
+/// How long the CLI asks `<ns>/host/plugins` whether a host is there, after a
+/// request timed out.
+const HOST_PROBE: Duration = Duration::from_secs(2);
+
+/// What a timeout means: a host that is there but did not answer in time, or
+/// no host on the bus at all (asked on `<ns>/host/plugins`).
+fn timed_out(client: &BusClient, bus: &BusArgs, key: &str, timeout: Duration) -> anyhow::Error {
+    let endpoint = bus.connect.clone().unwrap_or_else(default_endpoint);
+    let ms = timeout.as_millis();
+    match client.request_key(&client.keys().host_plugins(), b"", HOST_PROBE) {
+        Ok(_) => anyhow::anyhow!(
+            "the host on {endpoint} (namespace `{}`) is running but did not answer `{key}` within \
+             {ms} ms (--timeout-ms); a plan can take longer: raise --timeout-ms, or bound the \
+             plan with options.time_budget_ms",
+            bus.namespace
+        ),
+        Err(_) => anyhow::anyhow!(
+            "no host answered on {endpoint} (namespace `{}`): nothing replied to `{key}` within \
+             {ms} ms, and nothing answers `{}`; is `tsukami run` serving there?",
+            bus.namespace,
+            client.keys().host_plugins()
+        ),
+    }
 }
 
 fn print_reply(reply: Result<Vec<u8>, RequestError>) -> Result<ExitCode> {
