@@ -288,47 +288,36 @@ fn main() {
     clutter_rows(&mut tb, &mut det, trials_n, seed_offset, verbose);
 }
 
-/// Every model a distractor may be.
-const POOL: [&str; 5] = ["can_350ml", "can_200ml", "pet_500ml", "box", "vase"];
-
-/// The clutter of a condition: wall, floor and 1–3 distractors; `noisy`: σ
-/// 1–3 mm and 0.5–3 % dropout drawn per frame; `modes`: the target's resting
-/// modes (indices into `resting_modes`).
-fn clutter(noisy: bool, modes: &[usize]) -> Clutter {
-    Clutter {
-        wall: true,
-        floor: true,
-        distractors: (1, 3),
-        pool: POOL.iter().map(|m| m.to_string()).collect(),
-        modes: modes.to_vec(),
-        sigma: noisy.then_some((0.001, 0.003)),
-        dropout: noisy.then_some((0.005, 0.03)),
-        hide_target: false,
-    }
-}
-
 /// The clutter conditions of a target: name, clutter, occluder.
 fn conditions(target: &str, occluder: &str) -> Vec<(String, Clutter, Option<String>)> {
     let bottle = target.starts_with("pet");
     let mut out = vec![
-        ("wall+legs+distr".to_string(), clutter(false, &[]), None),
+        (
+            "wall+legs+distr".to_string(),
+            Clutter::benchmark(false, &[]),
+            None,
+        ),
         (
             "wall+legs+distr noisy".to_string(),
-            clutter(true, &[]),
+            Clutter::benchmark(true, &[]),
             None,
         ),
         (
             "lying, clutter".to_string(),
-            clutter(true, if bottle { &[1] } else { &[2, 3] }),
+            Clutter::benchmark(true, if bottle { &[1] } else { &[2, 3] }),
             None,
         ),
     ];
     if !bottle {
-        out.push(("upside down, clutter".into(), clutter(true, &[1]), None));
+        out.push((
+            "upside down, clutter".into(),
+            Clutter::benchmark(true, &[1]),
+            None,
+        ));
     }
     out.push((
         format!("+{occluder} 0-39%, clutter"),
-        clutter(true, &[]),
+        Clutter::benchmark(true, &[]),
         Some(occluder.to_string()),
     ));
     out
@@ -441,7 +430,7 @@ fn clutter_false_positives(
     let (in_frames, in_wrong) = (tally.asked, tally.wrong);
     let empty = Clutter {
         hide_target: true,
-        ..clutter(true, &[])
+        ..Clutter::benchmark(true, &[])
     };
     for i in 0..n {
         let t = tb

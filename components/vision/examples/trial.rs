@@ -26,21 +26,11 @@ use tsukami_vision::sim::testbed::{Clutter, Testbed, Trial};
 /// The trial of `seed`, in the benchmark's noisy clutter when `CLUTTER=1`.
 fn draw(tb: &mut Testbed, target: &str, occ: Option<&str>, seed: u64) -> Trial {
     let clutter = if std::env::var("CLUTTER").is_ok_and(|v| v == "1") {
-        Clutter {
-            wall: true,
-            floor: true,
-            distractors: (1, 3),
-            pool: ["can_350ml", "can_200ml", "pet_500ml", "box", "vase"]
-                .map(String::from)
-                .to_vec(),
-            sigma: Some((0.001, 0.003)),
-            dropout: Some((0.005, 0.03)),
-            modes: std::env::var("MODES")
-                .ok()
-                .map(|m| m.split(',').filter_map(|i| i.parse().ok()).collect())
-                .unwrap_or_default(),
-            ..Clutter::default()
-        }
+        let modes: Vec<usize> = std::env::var("MODES")
+            .ok()
+            .map(|m| m.split(',').filter_map(|i| i.parse().ok()).collect())
+            .unwrap_or_default();
+        Clutter::benchmark(true, &modes)
     } else {
         Clutter::default()
     };

@@ -84,23 +84,6 @@ fn poses_missed_before() {
     check(&mut tb, &mut det, "box", Some("pet_500ml"), 2500);
 }
 
-/// The benchmark's noisy clutter (issue 26): a wall behind the table, the
-/// floor and the table's legs, 1–3 distractors, σ 1–3 mm and dropout.
-fn clutter(modes: &[usize]) -> Clutter {
-    Clutter {
-        wall: true,
-        floor: true,
-        distractors: (1, 3),
-        pool: ["can_350ml", "can_200ml", "pet_500ml", "box", "vase"]
-            .map(String::from)
-            .to_vec(),
-        modes: modes.to_vec(),
-        sigma: Some((0.001, 0.003)),
-        dropout: Some((0.005, 0.03)),
-        hide_target: false,
-    }
-}
-
 /// Before issue 26 a wall behind the table, the legs and the distractors
 /// filled the six clusters examined and pushed the target out.
 #[test]
@@ -116,7 +99,13 @@ fn found_before_a_wall_among_distractors() {
         ("pet_500ml", &[][..], Some("box"), 11_316),
     ] {
         let trial = tb
-            .trial_in(object, occluder, 0.32, seed, &clutter(modes))
+            .trial_in(
+                object,
+                occluder,
+                0.32,
+                seed,
+                &Clutter::benchmark(true, modes),
+            )
             .unwrap();
         assert!(!trial.others.is_empty(), "{object} {seed}: no distractor");
         found_within(&mut det, object, seed, &trial);

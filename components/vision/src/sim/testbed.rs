@@ -77,6 +77,28 @@ pub struct Clutter {
     pub hide_target: bool,
 }
 
+/// Every model a distractor of the benchmark's clutter may be.
+pub const DISTRACTOR_POOL: [&str; 5] = ["can_350ml", "can_200ml", "pet_500ml", "box", "vase"];
+
+impl Clutter {
+    /// The vision benchmark's clutter (issue 26): a wall behind the table, the
+    /// floor and the table's legs, 1–3 distractors from [`DISTRACTOR_POOL`];
+    /// `noisy`: σ 1–3 mm and 0.5–3 % dropout drawn per frame; `modes`: the
+    /// target's resting modes (indices into [`resting_modes`], empty: all).
+    pub fn benchmark(noisy: bool, modes: &[usize]) -> Clutter {
+        Clutter {
+            wall: true,
+            floor: true,
+            distractors: (1, 3),
+            pool: DISTRACTOR_POOL.iter().map(|m| m.to_string()).collect(),
+            modes: modes.to_vec(),
+            sigma: noisy.then_some((0.001, 0.003)),
+            dropout: noisy.then_some((0.005, 0.03)),
+            hide_target: false,
+        }
+    }
+}
+
 /// One rendered trial.
 #[derive(Debug, Clone)]
 pub struct Trial {
