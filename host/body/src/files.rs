@@ -53,7 +53,7 @@ pub enum FileKind {
     Urdf,
     /// A TOML file (grasp types, object, scene).
     Toml,
-    /// A triangle mesh (STL, OBJ).
+    /// A triangle mesh (STL, OBJ, PLY, Collada).
     Mesh,
 }
 

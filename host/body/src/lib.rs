@@ -20,8 +20,8 @@
 //! ```
 //!
 //! Modules, lowest first: [`limits`] (parse limits, bounded reads),
-//! [`mesh`], [`mesh_clean`], [`mesh_io`] and [`mesh_inline`] (triangle meshes: STL, OBJ,
-//! Collada; files or base64 in a request), [`packages`] (`package://` lookup), [`model`], [`urdf_xml`] and
+//! [`mesh`], [`mesh_clean`], [`mesh_io`], [`ply`] and [`mesh_inline`] (triangle meshes: STL,
+//! OBJ, PLY, Collada; files or base64 in a request), [`packages`] (`package://` lookup), [`model`], [`urdf_xml`] and
 //! [`urdf`] (the kinematic tree, lenient or strict), [`kinematics`] (FK, Jacobians), [`ik`],
 //! [`collision`] (with its fast narrow phase [`capsule_mesh`]; [`collision_matrix`]
 //! proposes the link pairs a robot description may leave unchecked),
@@ -46,6 +46,7 @@ pub mod mesh_io;
 pub mod model;
 pub mod object;
 pub mod packages;
+pub mod ply;
 pub mod reach;
 pub mod scene;
 pub mod shape_spec;

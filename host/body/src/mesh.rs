@@ -4,7 +4,7 @@
 //! A [`TriangleMesh`] is plain data (vertices and index triples in the mesh's
 //! own frame) that callers such as the grasp planner can read directly, e.g.
 //! to fit the object's convex boxes (OCP). Files are read and written in
-//! [`crate::mesh_io`] (STL, OBJ, Collada), and meshes as they come are
+//! [`crate::mesh_io`] (STL, OBJ, PLY, Collada), and meshes as they come are
 //! cleaned in [`crate::mesh_clean`]: duplicate vertices merged, zero-area,
 //! non-finite and badly indexed triangles dropped and counted. Open and
 //! non-manifold meshes load; whether a mesh is closed (every edge shared by

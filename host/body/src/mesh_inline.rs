@@ -5,7 +5,7 @@
 //! turns the base64 text of a mesh file into its bytes, refusing it before
 //! decoding when the bytes would be more than a limit ([`decoded_len`] gives
 //! the exact count from the text alone);
-//! [`TriangleMesh::from_base64`] decodes and parses (STL, OBJ, Collada, as
+//! [`TriangleMesh::from_base64`] decodes and parses (STL, OBJ, PLY, Collada, as
 //! [`TriangleMesh::from_bytes_with`]), scales and cleans. [`InlineError`] says
 //! what was wrong: no data, too many bytes (with the count and the limit), not
 //! base64 (with the offset), too many triangles, or the mesh itself.
@@ -179,6 +179,7 @@ impl TriangleMesh {
         let label = match format {
             Format::Stl => "inline STL",
             Format::Obj => "inline OBJ",
+            Format::Ply => "inline PLY",
             Format::Collada => "inline Collada",
         };
         Self::from_bytes_with(&bytes, format, scale, limits, Path::new(label)).map_err(|e| {
@@ -264,7 +265,7 @@ mod tests {
         let e = parse("QUJDR", Format::Stl).unwrap_err().to_string();
         assert!(e.contains("5 symbols cannot be base64"), "{e}");
         let secret = "solid SECRET-TOKEN-123\nfacet nonsense 'SECRET-TOKEN-123-and-more'\n";
-        for format in [Format::Stl, Format::Obj, Format::Collada] {
+        for format in [Format::Stl, Format::Obj, Format::Ply, Format::Collada] {
             let e = parse(&b64(secret.as_bytes()), format)
                 .unwrap_err()
                 .to_string();
@@ -296,6 +297,43 @@ mod tests {
                 "{} decoded, more than the limit of 1000 bytes",
                 size(bytes.len() as u64)
             )
+        );
+    }
+
+    #[test]
+    fn a_ply_decodes_to_the_mesh_written_and_its_refusals_name_no_data() {
+        let cyl = TriangleMesh::cylinder(0.03, 0.1, 16);
+        let limits = ParseLimits::default();
+        let (mesh, report) = TriangleMesh::from_base64(
+            &b64(&crate::ply::to_binary(&cyl)),
+            Format::Ply,
+            Vector3::repeat(2.0),
+            &limits,
+        )
+        .unwrap();
+        assert_eq!(report.dropped(), 0);
+        assert_eq!(mesh.indices.len(), cyl.indices.len());
+        assert!(mesh.is_closed());
+        assert!((mesh.volume() - 8.0 * cyl.volume()).abs() < 1e-6);
+        let one = Vector3::repeat(1.0);
+        let lying = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n\
+            property float y\nproperty float z\nelement face 3000000\n\
+            property list uchar int vertex_indices\nend_header\n";
+        let e = TriangleMesh::from_base64(&b64(lying.as_bytes()), Format::Ply, one, &limits);
+        assert!(
+            matches!(&e, Err(InlineError::Triangles(m)) if m == "inline PLY: too large: 3000000 faces, more than the limit of 2000000 triangles"),
+            "{e:?}"
+        );
+        let secret =
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+            property float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n\
+            0 'SECRET-TOKEN' 0\n";
+        let e = TriangleMesh::from_base64(&b64(secret.as_bytes()), Format::Ply, one, &limits)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "inline PLY: bad mesh: cannot parse PLY: vertex 0 (line 10): a value is not a number"
         );
     }
 

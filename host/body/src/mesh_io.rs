@@ -1,25 +1,26 @@
-//! Mesh files: reading STL (ASCII and binary), OBJ and Collada (`.dae`), and
-//! writing STL and OBJ.
+//! Mesh files: reading STL (ASCII and binary), OBJ, PLY and Collada (`.dae`),
+//! and writing STL, OBJ and PLY.
 //!
 //! What: [`TriangleMesh::load`] and [`TriangleMesh::load_with`] read a mesh
 //! file, scale it, clean it ([`crate::mesh_clean`]) and refuse it only when no
 //! triangle is left; [`TriangleMesh::from_bytes_with`] does the same with a
 //! file's bytes already in memory (an inline mesh, [`crate::mesh_inline`]);
-//! [`TriangleMesh::write_stl`] and
-//! [`TriangleMesh::write_obj`] write one.
+//! [`TriangleMesh::write_stl`], [`TriangleMesh::write_obj`] and
+//! [`TriangleMesh::write_ply`] write one.
 //!
 //! Why: robot collections ship STL, OBJ and Collada (about 30 % of mesh
-//! references in a common collection are `.dae`); objects come as scans.
+//! references in a common collection are `.dae`); objects come as scans,
+//! often PLY.
 //!
 //! How: a binary STL is read directly (one pass, the same values
 //! `mesh-loader` gives); `mesh-loader` (from the urdf-rs authors) parses
 //! ASCII STL, OBJ and Collada; for Collada it applies the node transforms and the `<unit meter>` scale
 //! (the `up_axis` is ignored, as ROS tools do; node placement is done in
-//! [`crate::collada`]). The file is read through
+//! [`crate::collada`]); PLY is read by [`crate::ply`]. The file is read through
 //! [`crate::limits::read_bounded`], a Collada file's nesting is checked
 //! before parsing, and the triangle count is checked against
-//! [`ParseLimits::max_mesh_triangles`] (for binary STL before parsing, from
-//! the header). OBJ material libraries are not read. A parser panic on a
+//! [`ParseLimits::max_mesh_triangles`] (for binary STL and PLY before
+//! parsing, from the header). OBJ material libraries are not read. A parser panic on a
 //! hostile file becomes an error.
 //!
 //! ```
@@ -43,6 +44,7 @@ use crate::error::{BodyError, Result};
 use crate::limits::{check_xml_depth, read_bounded, ParseLimits};
 use crate::mesh::TriangleMesh;
 use crate::mesh_clean::MeshCleanup;
+use crate::ply::PlyError;
 
 /// The mesh formats the loader reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,6 +53,8 @@ pub enum Format {
     Stl,
     /// Wavefront OBJ (material libraries are not read).
     Obj,
+    /// PLY (Stanford polygon format), ASCII or binary.
+    Ply,
     /// Collada (`.dae`).
     Collada,
 }
@@ -64,7 +68,7 @@ impl Format {
 }
 
 impl TriangleMesh {
-    /// Loads an STL (binary or ASCII), OBJ or Collada file with the default
+    /// Loads an STL (binary or ASCII), OBJ, PLY or Collada file with the default
     /// [`ParseLimits`], scales every vertex by `scale` component-wise and
     /// cleans it. The format is chosen by the extension.
     pub fn load(path: &Path, scale: Vector3<f64>) -> Result<Self> {
@@ -169,6 +173,14 @@ impl TriangleMesh {
         std::fs::write(path, out).map_err(io_err)
     }
 
+    /// Writes a binary little-endian PLY file ([`crate::ply::to_binary`]).
+    pub fn write_ply(&self, path: &Path) -> Result<()> {
+        std::fs::write(path, crate::ply::to_binary(self)).map_err(|source| BodyError::Io {
+            file: path.to_path_buf(),
+            source,
+        })
+    }
+
     /// Writes a Wavefront OBJ file (positions and faces only).
     pub fn write_obj(&self, path: &Path) -> Result<()> {
         let io_err = |source| BodyError::Io {
@@ -196,9 +208,10 @@ fn format_of(path: &Path) -> std::result::Result<Format, String> {
     match ext.as_str() {
         "stl" => Ok(Format::Stl),
         "obj" => Ok(Format::Obj),
+        "ply" => Ok(Format::Ply),
         "dae" => Ok(Format::Collada),
         _ => Err(format!(
-            "unsupported mesh format '.{ext}' (use .stl, .obj or .dae)"
+            "unsupported mesh format '.{ext}' (use .stl, .obj, .ply or .dae)"
         )),
     }
 }
@@ -231,12 +244,21 @@ fn parse(path: &Path, bytes: &[u8], format: Format, limits: &ParseLimits) -> Res
             check_xml_depth(text, limits.max_xml_depth).map_err(err)?;
             return read_collada(text, path, limits.max_mesh_triangles).map_err(err);
         }
+        Format::Ply => {
+            return crate::ply::read(bytes, limits).map_err(|e| match e {
+                PlyError::TooLarge(message) => BodyError::TooLarge {
+                    file: path.to_path_buf(),
+                    message,
+                },
+                PlyError::Malformed(m) => err(format!("cannot parse PLY: {m}")),
+            });
+        }
         Format::Obj => {}
     }
     let loader = mesh_loader::Loader::default().merge_meshes(true);
     let parsed = std::panic::catch_unwind(|| match format {
         Format::Stl => loader.load_stl_from_slice(bytes, path),
-        Format::Collada => Err(std::io::Error::other("Collada is read by crate::collada")),
+        Format::Collada | Format::Ply => Err(std::io::Error::other("read by this crate")),
         Format::Obj => loader.load_obj_from_slice_with_reader(bytes, path, |_| {
             Err(std::io::Error::other("material libraries are not read"))
         }),
@@ -244,6 +266,7 @@ fn parse(path: &Path, bytes: &[u8], format: Format, limits: &ParseLimits) -> Res
     let kind = match format {
         Format::Stl => "STL",
         Format::Obj => "OBJ",
+        Format::Ply => "PLY",
         Format::Collada => "Collada",
     };
     let scene = match parsed {
@@ -318,14 +341,14 @@ mod tests {
     }
 
     #[test]
-    fn stl_and_obj_round_trip_with_scale() {
+    fn stl_obj_and_ply_round_trip_with_scale() {
         let c = TriangleMesh::cylinder(0.03, 0.1, 12);
-        for name in ["c.stl", "c.obj"] {
+        for name in ["c.stl", "c.obj", "c.ply", "C.PLY"] {
             let p = tmp(name);
-            if name.ends_with("stl") {
-                c.write_stl(&p).unwrap();
-            } else {
-                c.write_obj(&p).unwrap();
+            match Format::of_path(&p).unwrap() {
+                Format::Stl => c.write_stl(&p).unwrap(),
+                Format::Obj => c.write_obj(&p).unwrap(),
+                _ => c.write_ply(&p).unwrap(),
             }
             let back = TriangleMesh::load(&p, Vector3::new(2.0, 2.0, 2.0)).unwrap();
             assert_eq!(back.indices.len(), c.indices.len());
@@ -412,12 +435,26 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("big.stl") && e.contains("760 triangles"), "{e}");
+        let off = tmp("x.off");
+        std::fs::write(&off, b"OFF\n").unwrap();
+        let e = TriangleMesh::load(&off, Vector3::repeat(1.0))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("unsupported mesh format '.off'"), "{e}");
+        assert!(e.contains(".stl, .obj, .ply or .dae"), "{e}");
         let ply = tmp("x.ply");
         std::fs::write(&ply, b"ply\n").unwrap();
         let e = TriangleMesh::load(&ply, Vector3::repeat(1.0))
             .unwrap_err()
             .to_string();
-        assert!(e.contains("unsupported mesh format '.ply'"), "{e}");
+        assert!(e.contains("x.ply") && e.contains("cannot parse PLY"), "{e}");
+        TriangleMesh::uv_sphere(1.0, 20, 20)
+            .write_ply(&ply)
+            .unwrap();
+        let e = TriangleMesh::load_with(&ply, Vector3::repeat(1.0), &limits)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("x.ply: too large: 760 faces"), "{e}");
         let deep = tmp("deep.dae");
         std::fs::write(&deep, "<COLLADA>".repeat(10_000)).unwrap();
         let e = TriangleMesh::load(&deep, Vector3::repeat(1.0))

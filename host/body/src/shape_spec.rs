@@ -76,7 +76,7 @@ pub enum ShapeSpec {
         /// Radius (m).
         radius: f64,
     },
-    /// A triangle mesh file (STL or OBJ).
+    /// A triangle mesh file (STL, OBJ, PLY or Collada).
     Mesh {
         /// Path, relative to the TOML file.
         path: PathBuf,
