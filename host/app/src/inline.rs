@@ -13,7 +13,7 @@
 //!
 //! How: the file is read bounded ([`tsukami_body::limits::read_bounded`], a
 //! regular file of at most `max_bytes`), its format taken from the extension
-//! (`.stl`, `.obj`); nothing is parsed here — the host checks the mesh and
+//! (`.stl`, `.obj`, `.ply`); nothing is parsed here — the host checks the mesh and
 //! refuses one over its `max_mesh_bytes` or `max_payload_bytes`.
 //!
 //! ```
@@ -47,7 +47,7 @@ pub fn inline_local_mesh(req: &mut SetObject, max_bytes: u64) -> Result<()> {
     let file = Path::new(path);
     let ext = file.extension().and_then(|e| e.to_str()).unwrap_or("");
     let Some(format) = MeshFormat::from_extension(ext) else {
-        bail!("{path}: an inline mesh is an .stl or .obj file, not `.{ext}`");
+        bail!("{path}: an inline mesh is an .stl, .obj or .ply file, not `.{ext}`");
     };
     let bytes = tsukami_body::limits::read_bounded(file, max_bytes, "mesh")
         .with_context(|| format!("reading the mesh to send inline ({path})"))?;
@@ -73,11 +73,24 @@ mod tests {
     }
 
     #[test]
-    fn only_a_local_stl_or_obj_within_the_limit_is_sent() {
+    fn only_a_local_stl_obj_or_ply_within_the_limit_is_sent() {
         let dir = std::env::temp_dir().join(format!("tsukami-inline-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let ply = dir.join("a.ply");
+        let dae = dir.join("a.dae");
+        std::fs::write(&dae, b"<COLLADA/>\n").unwrap();
+        let ply = dir.join("scan.ply");
         std::fs::write(&ply, b"ply\n").unwrap();
+        let mut scan = request(serde_json::json!({"mesh": {"path": ply, "scale": 0.001}}));
+        inline_local_mesh(&mut scan, 100).unwrap();
+        assert_eq!(scan.name.as_deref(), Some("scan"));
+        assert_eq!(
+            scan.shape,
+            ObjectShape::Inline {
+                format: MeshFormat::Ply,
+                data_base64: encode_base64(b"ply\n"),
+                scale: Some(0.001),
+            }
+        );
         let obj = dir.join("Box.OBJ");
         std::fs::write(&obj, b"v 0 0 0\n").unwrap();
         let mut named = request(serde_json::json!({"mesh": {"path": obj}}));
@@ -97,7 +110,11 @@ mod tests {
                 .unwrap_err()
                 .to_string()
         };
-        assert!(e(serde_json::json!({"mesh": {"path": ply}}), 100).contains("not `.ply`"));
+        let collada = e(serde_json::json!({"mesh": {"path": dae}}), 100);
+        assert!(
+            collada.contains("an .stl, .obj or .ply file, not `.dae`"),
+            "{collada}"
+        );
         let big = e(serde_json::json!({"mesh": {"path": obj}}), 4);
         assert!(big.contains("reading the mesh to send inline"), "{big}");
         let model = e(serde_json::json!({"model": {"name": "can_350ml"}}), 100);

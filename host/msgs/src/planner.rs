@@ -104,7 +104,8 @@ pub struct RobotSummary {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum ObjectShape {
-    /// A triangle mesh file (STL or OBJ), any object, seen before or not.
+    /// A triangle mesh file (STL, OBJ, PLY or Collada, by its extension), any
+    /// object, seen before or not.
     Mesh {
         /// File path.
         path: String,
@@ -142,25 +143,31 @@ pub enum MeshFormat {
     Stl,
     /// Wavefront OBJ (positions and faces; material libraries are not read).
     Obj,
+    /// PLY (Stanford polygon format), ASCII or binary: vertex positions and
+    /// faces (polygons are fan-triangulated); other properties and elements
+    /// are skipped.
+    Ply,
 }
 
 impl MeshFormat {
-    /// The format's usual file extension (`"stl"`, `"obj"`), which is also its
-    /// name on the wire.
+    /// Every format, in wire order.
+    pub const ALL: [MeshFormat; 3] = [MeshFormat::Stl, MeshFormat::Obj, MeshFormat::Ply];
+
+    /// The format's usual file extension (`"stl"`, `"obj"`, `"ply"`), which
+    /// is also its name on the wire.
     pub fn extension(self) -> &'static str {
         match self {
             MeshFormat::Stl => "stl",
             MeshFormat::Obj => "obj",
+            MeshFormat::Ply => "ply",
         }
     }
 
     /// The format a file extension names (case-insensitive), if any.
     pub fn from_extension(ext: &str) -> Option<Self> {
-        match ext.to_ascii_lowercase().as_str() {
-            "stl" => Some(MeshFormat::Stl),
-            "obj" => Some(MeshFormat::Obj),
-            _ => None,
-        }
+        Self::ALL
+            .into_iter()
+            .find(|f| ext.eq_ignore_ascii_case(f.extension()))
     }
 }
 
@@ -347,7 +354,7 @@ pub enum ObstacleShape {
         /// Radius in metres.
         radius: f64,
     },
-    /// A triangle mesh file (STL or OBJ).
+    /// A triangle mesh file (STL, OBJ, PLY or Collada, by its extension).
     Mesh {
         /// File path.
         path: String,
@@ -1086,5 +1093,24 @@ mod tests {
         matches_schema("plan_reply", &schema, &reply, &schema);
         let limit = &resolve(&schema["properties"]["force_closure"], &schema)["properties"];
         assert!(limit["force_limit"].is_object(), "{limit}");
+    }
+
+    #[test]
+    fn mesh_formats_are_named_by_their_extension_on_the_wire() {
+        for format in MeshFormat::ALL {
+            let wire = serde_json::to_value(format).unwrap();
+            assert_eq!(wire, format.extension());
+            assert_eq!(serde_json::from_value::<MeshFormat>(wire).unwrap(), format);
+            let upper = format.extension().to_ascii_uppercase();
+            assert_eq!(MeshFormat::from_extension(&upper), Some(format));
+        }
+        assert_eq!(MeshFormat::from_extension("ply"), Some(MeshFormat::Ply));
+        assert_eq!(MeshFormat::from_extension("dae"), None);
+        let e = serde_json::from_str::<MeshFormat>(r#""off""#).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("unknown variant `off`, expected one of `stl`, `obj`, `ply`"),
+            "{e}"
+        );
     }
 }

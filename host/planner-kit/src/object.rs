@@ -168,6 +168,7 @@ pub fn load_inline(
     let format = match format {
         MeshFormat::Stl => Format::Stl,
         MeshFormat::Obj => Format::Obj,
+        MeshFormat::Ply => Format::Ply,
     };
     let (mesh, cleanup) =
         TriangleMesh::from_base64(data_base64, format, Vector3::repeat(s), &limits).map_err(
@@ -543,6 +544,42 @@ mod tests {
         let o = Object::build(&models, &req, &Limits::default()).unwrap();
         assert_eq!(o.name, "client box");
         assert!(o.topology.closed && o.volume > 0.0);
+    }
+
+    #[test]
+    fn an_inline_ply_is_the_object_its_stl_is() {
+        let models = Models::new([models_dir()]);
+        let limits = Limits::default();
+        let stl = models_dir().join("objects/can_350ml/can_350ml.stl");
+        let can = TriangleMesh::load(&stl, Vector3::repeat(1.0)).unwrap();
+        let ply = tsukami_body::ply::to_binary(&can);
+        let sent = Object::build(&models, &inline(MeshFormat::Ply, b64(&ply), None), &limits);
+        let sent = sent.unwrap();
+        let mut by_path = inline(MeshFormat::Stl, String::new(), None);
+        by_path.shape = ObjectShape::Mesh {
+            path: "objects/can_350ml/can_350ml.stl".into(),
+            scale: None,
+        };
+        let read = Object::build(&models, &by_path, &limits).unwrap();
+        assert_eq!(sent.mesh, read.mesh);
+        assert_eq!(sent.com_local, read.com_local);
+        // A header stating more faces than accepted: refused from the header.
+        let lying = format!(
+            "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n\
+             property float y\nproperty float z\nelement face {}\n\
+             property list uchar int vertex_indices\nend_header\n",
+            MAX_TRIANGLES + 1
+        );
+        let req = inline(MeshFormat::Ply, b64(lying.as_bytes()), None);
+        let e = Object::build(&models, &req, &limits).unwrap_err();
+        let (field, message) = field_and_message(&e);
+        assert_eq!(e.code(), tsukami_msgs::ErrorCode::InvalidValue);
+        assert_eq!(field, "shape.inline.data_base64");
+        assert!(
+            message.contains("inline PLY: too large: 2000001 faces")
+                && message.contains("MAX_TRIANGLES = 2000000"),
+            "{message}"
+        );
     }
 
     #[test]

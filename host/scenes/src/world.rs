@@ -266,6 +266,7 @@ fn load_object(models_dir: &Path, req: &SetObject) -> Result<ObjectWorld, WorldE
             let format = match format {
                 MeshFormat::Stl => Format::Stl,
                 MeshFormat::Obj => Format::Obj,
+                MeshFormat::Ply => Format::Ply,
             };
             let s = Vector3::repeat(scale.unwrap_or(1.0));
             let (mesh, _) =

@@ -94,7 +94,7 @@ struct SetObjectArgs {
     #[command(flatten)]
     payload: Payload,
     /// Send the file named by `shape.mesh.path` (on this machine) inline, as
-    /// base64 in the request, for a host on another machine (`.stl`, `.obj`;
+    /// base64 in the request, for a host on another machine (`.stl`, `.obj`, `.ply`;
     /// the host refuses one over its `max_mesh_bytes` or `max_payload_bytes`).
     #[arg(long)]
     inline: bool,
