@@ -394,9 +394,50 @@ fn path_cases(
     cases
 }
 
+/// PLY files the host must refuse before allocating for them or reading past
+/// them: a header claiming 10^12 vertices, one whose skipped element claims
+/// 2^64 - 1 records, a face list claiming four billion corners, a face naming a
+/// vertex that does not exist, and a header that never ends.
+fn hostile_plys() -> [(&'static str, Vec<u8>); 5] {
+    let header = |vertices: &str, other: &str, list: &str| {
+        format!(
+            "ply\nformat binary_little_endian 1.0\nelement vertex {vertices}\nproperty float x\n\
+             property float y\nproperty float z\n{other}element face 1\n\
+             property list {list} int vertex_indices\nend_header\n"
+        )
+        .into_bytes()
+    };
+    let mut corners = header("3", "", "uint");
+    corners.extend_from_slice(&[0u8; 36]);
+    corners.extend_from_slice(&u32::MAX.to_le_bytes());
+    let mut bad_index = header("3", "", "uchar");
+    bad_index.extend_from_slice(&[0u8; 36]);
+    bad_index.push(3);
+    for i in [0i32, 1, i32::MAX] {
+        bad_index.extend_from_slice(&i.to_le_bytes());
+    }
+    let mut endless = b"ply\n".to_vec();
+    endless.extend(b"comment x\n".repeat(10_000));
+    [
+        ("ply vertices", header("1000000000000", "", "uchar")),
+        (
+            "ply skipped",
+            header(
+                "0",
+                "element e 18446744073709551615\nproperty char a\n",
+                "uchar",
+            ),
+        ),
+        ("ply corners", corners),
+        ("ply bad index", bad_index),
+        ("ply endless header", endless),
+    ]
+}
+
 /// Inline meshes (`shape.inline`) the host must refuse without changing
 /// anything: not base64, no string, zeros, a count the bytes do not hold, an OBJ
-/// asking for a material library outside the roots, indices out of range, NaN.
+/// asking for a material library outside the roots, indices out of range, NaN,
+/// and hostile PLY files ([`hostile_plys`]).
 fn inline_cases(object: &serde_json::Value) -> Vec<Case> {
     let b64 = tsukami_body::mesh_inline::encode_base64;
     let mut lying = vec![0u8; 80];
@@ -446,8 +487,10 @@ endsolid n
             .into(),
         ),
     ];
+    let plys = hostile_plys().map(|(name, bytes)| (name, "ply", b64(&bytes).into()));
     shapes
         .into_iter()
+        .chain(plys)
         .map(|(name, format, data)| {
             let mut o = object.clone();
             o["shape"] = serde_json::json!({"inline": {"format": format, "data_base64": data}});
@@ -508,10 +551,18 @@ fn corpus(robot: &serde_json::Value, object: &serde_json::Value, paths: &[String
 
 /// Cases whose files must reach the parser or the size check (so the corpus
 /// keeps testing them), and what their refusal says.
-const REACHED: [(&str, &str); 9] = [
+const REACHED: [(&str, &str); 14] = [
     ("inline not base64", "outside the alphabet"),
     ("inline zeros", "inline STL"),
     ("inline nan", "non-finite"),
+    ("inline ply vertices", "1000000000000 vertices, more than"),
+    ("inline ply skipped", "18446744073709551615 records"),
+    ("inline ply corners", "4294967293 triangles by face 0"),
+    (
+        "inline ply bad index",
+        "corner 2 of 3 names a vertex outside",
+    ),
+    ("inline ply endless header", "no `end_header` within"),
     ("robot deep", "nested deeper than"),
     ("robot many", "more than 10000 links"),
     ("mesh nan.stl", "non-finite"),

@@ -1,7 +1,7 @@
 //! Objects over the bus (issue #26): a client in another process than the host
 //! — this test, over zenoh on loopback, to a `tsukami run` child process — sends
-//! its own mesh inline in `set_object` (`shape.inline`: base64 of a binary STL
-//! or an OBJ file) and plans on it.
+//! its own mesh inline in `set_object` (`shape.inline`: base64 of a binary STL,
+//! an OBJ or a PLY file) and plans on it.
 //!
 //! Every world-aware plugin (grasp planner, trajectory planner, result viewer)
 //! takes the inline mesh: the grasp is the one the model of the same mesh gets,
@@ -88,6 +88,14 @@ fn scene_with(shape: Value) -> (Value, Value, Value) {
 
 fn can_stl() -> Vec<u8> {
     std::fs::read(models_dir().join("objects/can_350ml/can_350ml.stl")).unwrap()
+}
+
+/// The can as a scanner or MeshLab would send it: a binary PLY of the same
+/// triangles.
+fn can_ply() -> Vec<u8> {
+    let path = models_dir().join("objects/can_350ml/can_350ml.stl");
+    let can = TriangleMesh::load(&path, nalgebra::Vector3::repeat(1.0)).unwrap();
+    tsukami_body::ply::to_binary(&can)
 }
 
 fn inline(format: &str, bytes: &[u8]) -> Value {
@@ -191,6 +199,51 @@ fn an_inline_mesh_from_another_process_plans_on_every_plugin() {
     assert_eq!(grasp_of(&again), grasp_of(&by_model));
 }
 
+#[test]
+fn an_inline_ply_plans_the_grasp_of_its_model_from_json_and_from_the_cli() {
+    let dir = temp_dir("ply");
+    let config = test_config(vec![planner_entry()]);
+    let (_host, c) = host_process(&dir.0, &config);
+    set_scene(&c, json!({"model": {"name": "can_350ml"}}));
+    let by_model = plan(&c);
+    // The can's mesh as a PLY, base64 in the request.
+    let summary = set_scene(&c, inline("ply", &can_ply()));
+    assert_eq!(summary["triangles"], 480, "{summary}");
+    let state = world(&c, "get", b"{}").unwrap();
+    assert_eq!(state["object"]["shape"]["inline"]["format"], "ply");
+    let grasp = plan(&c);
+    assert_eq!(grasp["world_version"], state["version"]);
+    assert_eq!(grasp_of(&grasp), grasp_of(&by_model));
+    // `tsukami set-object --inline` takes a `.ply` of the client's disk by its
+    // extension.
+    let copy = dir.0.join("Scanned_Can.PLY");
+    std::fs::write(&copy, can_ply()).unwrap();
+    let (_, mut object, _) = scene_with(json!({"mesh": {"path": copy}}));
+    object.as_object_mut().unwrap().remove("name");
+    let out = Command::new(tsukami_exe())
+        .args(["set-object", "--inline", &object.to_string()])
+        .args([
+            "--connect",
+            &config.bus.listen[0],
+            "--namespace",
+            &config.namespace,
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(r["name"], "Scanned_Can", "{r}");
+    let state = world(&c, "get", b"{}").unwrap();
+    assert_eq!(state["object"]["shape"]["inline"]["format"], "ply");
+    let again = plan(&c);
+    assert_eq!(again["world_version"], r["world_version"]);
+    assert_eq!(grasp_of(&again), grasp_of(&by_model));
+}
+
 /// A binary STL of a UV sphere with about `triangles` triangles.
 fn sphere_stl(dir: &Path, triangles: usize) -> Vec<u8> {
     let rings = ((triangles / 2) as f64).sqrt() as usize;
@@ -225,6 +278,17 @@ fn too_large_bad_and_garbage_inline_meshes_are_refused_and_the_world_stays() {
     }
     nan.extend_from_slice(&[0, 0]);
     let huge = vec![b'A'; 2 << 20];
+    let vertex = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+    let lying_ply = "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\n\
+        property float x\nproperty float y\nproperty float z\nelement face 1\n\
+        property list uchar int vertex_indices\nend_header\n";
+    let bad_index_ply = format!(
+        "ply\nformat ascii 1.0\n{vertex}element face 1\n\
+         property list uchar int vertex_indices\nend_header\n\
+         0 0 0\n1 0 0\n0 1 0\n3 0 1 3 TSUKAMI-GARBAGE\n"
+    );
+    let point_cloud =
+        format!("ply\nformat ascii 1.0\n{vertex}end_header\n0 0 0\n1 0 0\nTSUKAMI-GARBAGE\n");
     let cases: Vec<(&str, Value, &str, Vec<String>)> = vec![
         (
             "over max_mesh_bytes",
@@ -284,9 +348,44 @@ fn too_large_bad_and_garbage_inline_meshes_are_refused_and_the_world_stays() {
         ),
         (
             "unknown format",
-            json!({"inline": {"format": "ply", "data_base64": "cGx5Cg=="}}),
+            json!({"inline": {"format": "off", "data_base64": "T0ZGCg=="}}),
             "invalid_request",
-            vec!["ply".into(), "stl".into(), "obj".into()],
+            vec![
+                "shape.inline.format".into(),
+                "unknown variant `off`, expected one of `stl`, `obj`, `ply`".into(),
+            ],
+        ),
+        (
+            "a PLY header claiming 10^12 vertices",
+            inline("ply", lying_ply.as_bytes()),
+            "invalid_value",
+            vec![
+                "shape.inline.data_base64".into(),
+                "inline PLY: too large: 1000000000000 vertices".into(),
+                "MAX_TRIANGLES".into(),
+            ],
+        ),
+        (
+            "a PLY face naming a missing vertex",
+            inline("ply", bad_index_ply.as_bytes()),
+            "model_error",
+            vec![
+                "shape.inline.data_base64".into(),
+                "inline PLY".into(),
+                "face 0 (line 13): corner 2 of 3 names a vertex outside the 3 of the file".into(),
+            ],
+        ),
+        (
+            "a truncated PLY",
+            inline("ply", &can_ply()[..1000]),
+            "model_error",
+            vec!["inline PLY".into(), "do not fit".into()],
+        ),
+        (
+            "a PLY point cloud",
+            inline("ply", point_cloud.as_bytes()),
+            "model_error",
+            vec!["inline PLY".into(), "a point cloud, not a mesh".into()],
         ),
         (
             "a path beside the data",
