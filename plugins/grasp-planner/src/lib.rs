@@ -34,6 +34,7 @@
 
 pub mod clearance;
 pub mod closing_speed;
+pub mod edges;
 pub mod finger_closing;
 pub mod grasp_type;
 pub mod hand;

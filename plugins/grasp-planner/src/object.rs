@@ -22,6 +22,7 @@ use tsukami_body::collision::CollisionObject;
 use tsukami_body::mesh::TriangleMesh;
 use tsukami_planner_kit::Object;
 
+use crate::edges::SharpEdges;
 use crate::ocp::{object_ocps, Ocp, OcpParams};
 
 /// Largest object size accepted (bounding-box diagonal, m).
@@ -91,6 +92,8 @@ pub struct PlanObject {
     pub characteristic_length: f64,
     /// Height of the lowest vertex (m, world): where a support under it is.
     pub lowest: f64,
+    /// Its sharp edges (world frame): where fingertips slide off.
+    pub edges: SharpEdges,
 }
 
 impl PlanObject {
@@ -136,6 +139,7 @@ impl PlanObject {
             collision: o.collision.clone(),
             characteristic_length,
             lowest: vertices.iter().map(|v| v.z).fold(f64::INFINITY, f64::min),
+            edges: SharpEdges::new(&vertices, &o.mesh.indices),
             vertices,
         })
     }

@@ -334,7 +334,7 @@ impl Paper {
             // or its hold margin is below the preferred one): taken only when
             // no other nominal pose of this stage gives a preferred one.
             let pm = opts.hold.preferred_margin;
-            let mut partial: Option<((u32, f64), Grasp)> = None;
+            let mut partial: Option<((u32, bool, f64), Grasp)> = None;
             for (k, nom) in nominals
                 .iter()
                 .take(opts.max_candidates.max(1) as usize)

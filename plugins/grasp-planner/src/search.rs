@@ -54,6 +54,7 @@ use tsukami_msgs::planner::{HoldRequest, PoseRobustness};
 use tsukami_planner_kit::blocks::hold::{holds_under, HoldContact, HoldProblem};
 use tsukami_planner_kit::blocks::wrap::{style_check, StyleRule};
 
+use crate::edges::EDGE_CLEARANCE;
 use crate::finger_closing::{close_fingers, FingerContact};
 use crate::hand::HandModel;
 use crate::link_sets::LinkSets;
@@ -141,19 +142,34 @@ pub struct Found {
     pub robustness: PoseRobustness,
     /// The exact hold margin (the multiple of every disturbance it resists).
     pub hold_margin: f64,
+    /// How far its nearest contact is from a sharp edge of the object (m).
+    pub edge_distance: f64,
 }
 
 impl Found {
     /// Whether it is a grasp the planner prefers: it holds under every pose
-    /// error and resists `preferred_margin` times every disturbance.
+    /// error, resists `preferred_margin` times every disturbance and keeps its
+    /// contacts off the object's sharp edges ([`Found::off_edges`]).
     pub fn preferred(&self, preferred_margin: f64) -> bool {
-        self.robustness.held == self.robustness.samples && self.hold_margin >= preferred_margin
+        self.robustness.held == self.robustness.samples
+            && self.hold_margin >= preferred_margin
+            && self.off_edges()
+    }
+
+    /// Whether every contact keeps [`EDGE_CLEARANCE`] from the object's sharp edges.
+    pub fn off_edges(&self) -> bool {
+        self.edge_distance >= EDGE_CLEARANCE
     }
 
     /// Its rank among grasps that are not preferred (higher is better): the
-    /// pose errors it holds under, then its margin up to `preferred_margin`.
-    pub fn rank(&self, preferred_margin: f64) -> (u32, f64) {
-        (self.robustness.held, self.hold_margin.min(preferred_margin))
+    /// pose errors it holds under, then whether its contacts are off the
+    /// edges, then its margin up to `preferred_margin`.
+    pub fn rank(&self, preferred_margin: f64) -> (u32, bool, f64) {
+        (
+            self.robustness.held,
+            self.off_edges(),
+            self.hold_margin.min(preferred_margin),
+        )
     }
 }
 
@@ -183,7 +199,7 @@ pub enum Outcome {
 }
 
 /// The reasons a sample is rejected, in the order of [`Counters::rejections`].
-pub const REJECTION_REASONS: [&str; 11] = [
+pub const REJECTION_REASONS: [&str; 12] = [
     "ik",
     "collision before closing",
     "finger closing",
@@ -195,6 +211,7 @@ pub const REJECTION_REASONS: [&str; 11] = [
     "too compliant",
     "motion blocked",
     "below preferred margin",
+    "contact on an edge",
 ];
 
 /// Samples a search goes on drawing, after its first accepted grasp that is
@@ -213,7 +230,7 @@ pub struct Counters {
     /// Best ellipsoid margin seen.
     pub best_margin: Option<f64>,
     /// Why samples were rejected, per [`REJECTION_REASONS`].
-    pub rejections: [u32; 11],
+    pub rejections: [u32; 12],
     /// What blocked the collision-rejected samples: `"<link> vs <obstacle>"`
     /// (or `"… vs <link>"` for self-collision) with counts.
     pub blockers: BTreeMap<String, u32>,
@@ -298,8 +315,15 @@ pub fn search(
             if found.preferred(preferred) {
                 return Some(Outcome::Found(found));
             }
-            let held_all = found.robustness.held == found.robustness.samples;
-            counters.reject(if held_all { 10 } else { 7 }, None);
+            let reason = match (
+                found.robustness.held == found.robustness.samples,
+                found.off_edges(),
+            ) {
+                (false, _) => 7,
+                (true, false) => 11,
+                (true, true) => 10,
+            };
+            counters.reject(reason, None);
             if best.is_none() {
                 stop_at.set(at.saturating_add(ROBUST_EXTRA_SAMPLES));
             }
@@ -405,12 +429,16 @@ fn sample_loop(
         let found = Found {
             q: q.clone(),
             palm,
-            contacts,
             margin,
             exact_resists_weight: true,
             exact_ms,
             robustness: PoseRobustness::default(),
             hold_margin: 0.0,
+            edge_distance: contacts
+                .iter()
+                .map(|c| ctx.object.edges.distance(&c.position))
+                .fold(f64::INFINITY, f64::min),
+            contacts,
         };
         if let Some(done) = on_found(found, s, counters) {
             return done;
