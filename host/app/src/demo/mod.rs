@@ -365,7 +365,7 @@ impl Demo<'_> {
         let vision = self.vision(name, &file, &vision_process);
         drop(vision_process);
         let seen = match (&vision.data, vision.status, self.args.plan_on) {
-            (Some(v), StepStatus::Ok, PlanOn::Vision) => Some(v.pose),
+            (Some(v), StepStatus::Ok, PlanOn::Vision) => Some(v.plan_pose),
             _ => None,
         };
         let planned_on = if seen.is_some() {

@@ -31,11 +31,11 @@
 
 use std::time::{Duration, Instant};
 
-use nalgebra::{Isometry3, Point3, Vector3};
+use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
 use serde::Serialize;
 use tsukami_msgs::vision::{DetectRequest, ObjectPose};
 use tsukami_msgs::Pose;
-use tsukami_scenes::geometry::pose_to_isometry;
+use tsukami_scenes::geometry::{isometry_to_pose, pose_to_isometry};
 
 use crate::client::BusClient;
 
@@ -63,6 +63,10 @@ pub struct VisionCheck {
     pub detect_ms: f64,
     /// The reported pose.
     pub pose: Pose,
+    /// The pose a grasp is planned on (`--plan-on vision`): `pose` turned within
+    /// the object's symmetry to the member nearest the scene file's
+    /// ([`nearest_member`]).
+    pub plan_pose: Pose,
 }
 
 /// Asks the vision component for `object` in a simulated frame (noise seeded by
@@ -100,27 +104,50 @@ pub fn detect(
         fit_error_mm: found.fit_error * 1e3,
         detect_ms,
         pose: found.pose,
+        plan_pose: nearest_member(&found, truth)?,
     })
+}
+
+/// The reported pose, its symmetry motions (the identity first) and its
+/// continuous axis (a point and a unit direction, object frame), parsed.
+struct Members {
+    estimate: Isometry3<f64>,
+    motions: Vec<Isometry3<f64>>,
+    axis: Option<(Point3<f64>, Vector3<f64>)>,
+}
+
+impl Members {
+    fn of(found: &ObjectPose) -> Result<Self, String> {
+        let estimate = pose_to_isometry(&found.pose).map_err(|e| format!("vision pose: {e}"))?;
+        let mut motions = vec![Isometry3::identity()];
+        let axis = found.symmetry.as_ref().and_then(|s| s.axis);
+        if let Some(symmetry) = &found.symmetry {
+            for pose in &symmetry.discrete {
+                motions.push(pose_to_isometry(pose).map_err(|e| format!("symmetry: {e}"))?);
+            }
+        }
+        let axis = axis.map(|a| (Point3::from(a.point), Vector3::from(a.direction).normalize()));
+        Ok(Members {
+            estimate,
+            motions,
+            axis,
+        })
+    }
 }
 
 /// Position (m) and orientation (rad) error of `found` against `truth`, modulo
 /// the symmetry `found` reports.
 pub fn pose_error(found: &ObjectPose, truth: &Pose) -> Result<(f64, f64), String> {
-    let estimate = pose_to_isometry(&found.pose).map_err(|e| format!("vision pose: {e}"))?;
+    let Members {
+        estimate,
+        motions,
+        axis,
+    } = Members::of(found)?;
     let truth = pose_to_isometry(truth).map_err(|e| format!("scene pose: {e}"))?;
-    let mut motions = vec![Isometry3::identity()];
-    let axis = found.symmetry.as_ref().and_then(|s| s.axis);
-    if let Some(symmetry) = &found.symmetry {
-        for pose in &symmetry.discrete {
-            motions.push(pose_to_isometry(pose).map_err(|e| format!("symmetry: {e}"))?);
-        }
-    }
     let error = |motion: &Isometry3<f64>| {
         let t = truth * motion;
         match axis {
-            Some(axis) => {
-                let point = Point3::from(axis.point);
-                let direction = Vector3::from(axis.direction).normalize();
+            Some((point, direction)) => {
                 let dist = (estimate * point - t * point).norm();
                 (dist, (estimate * direction).angle(&(t * direction)))
             }
@@ -135,6 +162,44 @@ pub fn pose_error(found: &ObjectPose, truth: &Pose) -> Result<(f64, f64), String
         .map(error)
         .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.total_cmp(&b.0)))
         .unwrap_or((f64::INFINITY, f64::INFINITY)))
+}
+
+/// The member of `found`'s symmetry set nearest `reference`: the reported
+/// pose composed with the discrete symmetry and the turn about the continuous
+/// axis that bring its frame closest to `reference`'s. What the vision
+/// measured (where the axis is and where it points, which shape it saw) is
+/// unchanged; only what no image can tell — the turn of a can about its axis
+/// — is taken from `reference`, so that a faceted mesh's facets lie where the
+/// reference's do.
+pub fn nearest_member(found: &ObjectPose, reference: &Pose) -> Result<Pose, String> {
+    let Members {
+        estimate,
+        motions,
+        axis,
+    } = Members::of(found)?;
+    let reference = pose_to_isometry(reference).map_err(|e| format!("scene pose: {e}"))?;
+    let member = |motion: &Isometry3<f64>| {
+        let pose = estimate * motion;
+        let Some((point, direction)) = axis else {
+            return pose;
+        };
+        let q = (pose.rotation.inverse() * reference.rotation).into_inner();
+        let along = q.imag().dot(&direction);
+        let turn = UnitQuaternion::from_axis_angle(
+            &nalgebra::Unit::new_unchecked(direction),
+            2.0 * along.atan2(q.w),
+        );
+        pose * Isometry3::rotation_wrt_point(turn, point)
+    };
+    let best = motions
+        .iter()
+        .map(member)
+        .min_by(|a, b| {
+            let angle = |p: &Isometry3<f64>| p.rotation.angle_to(&reference.rotation);
+            angle(a).total_cmp(&angle(b))
+        })
+        .unwrap_or(estimate);
+    Ok(isometry_to_pose(&best))
 }
 
 #[cfg(test)]
@@ -189,6 +254,39 @@ mod tests {
         let (d, a) = pose_error(&seen(tilted, Some(axis)), &truth).unwrap();
         assert!((a - 0.1).abs() < 1e-9, "{a}");
         assert!((d - 2.0 * 0.06 * (0.05f64).sin()).abs() < 1e-9, "{d}");
+    }
+
+    #[test]
+    fn the_member_planned_on_keeps_what_was_seen_and_takes_the_spin_from_the_scene() {
+        let axis = Symmetry {
+            axis: Some(SymmetryAxis {
+                point: [0.0, 0.0, 0.06],
+                direction: [0.0, 0.0, 1.0],
+            }),
+            discrete: vec![about_z(std::f64::consts::PI, [0.0; 3])],
+            note: String::new(),
+        };
+        let truth = about_z(0.3, [0.5, 0.0, 1.0]);
+        // Seen 2 mm to the side, tilted 0.02 rad about x, spun 2.5 rad.
+        let (s, c) = (0.01f64).sin_cos();
+        let tilt = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(c, s, 0.0, 0.0));
+        let spin = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 2.5);
+        let q = (tilt * spin).into_inner();
+        let seen_pose = Pose {
+            position: [0.5, 0.002, 1.0],
+            quaternion: [q.i, q.j, q.k, q.w],
+        };
+        let found = seen(seen_pose, Some(axis));
+        let member = nearest_member(&found, &truth).unwrap();
+        // Only the tilt is left against the truth, and the error is unchanged.
+        let (m, t) = (pose_to_isometry(&member).unwrap(), pose_to_isometry(&truth).unwrap());
+        assert!((m.rotation.angle_to(&t.rotation) - 0.02).abs() < 1e-9);
+        let (d0, a0) = pose_error(&found, &truth).unwrap();
+        let (d1, a1) = pose_error(&seen(member, found.symmetry.clone()), &truth).unwrap();
+        assert!((d0 - d1).abs() < 1e-12 && (a0 - a1).abs() < 1e-12, "{d0} {d1} {a0} {a1}");
+        // Without a symmetry, the pose is what was seen.
+        let plain = nearest_member(&seen(seen_pose, None), &truth).unwrap();
+        assert_eq!(plain.position, seen_pose.position);
     }
 
     #[test]
