@@ -1,12 +1,15 @@
-//! The demo's vision step: the vision component finds the scene's object in a
-//! frame of its simulated head camera, and the pose it reports is compared with
+//! The demo's vision step: the vision component looks for the scene's object
+//! with its simulated head camera, and the pose it reports is compared with
 //! the scene file's.
 //!
-//! What: [`detect`] asks `<ns>/vision/detect` and returns a [`VisionCheck`];
-//! [`pose_error`] is the symmetry-aware distance between two poses.
+//! What: [`detect`] asks `<ns>/vision/look` and returns a [`VisionCheck`]
+//! (with the views the look took); [`pose_error`] is the symmetry-aware
+//! distance between two poses; [`nearest_member`] the pose planned on.
 //!
-//! Why: the paper's robot measures the object with its head cameras before it
-//! plans; the demo shows how far that measurement is from the truth.
+//! Why: the paper's robot looks before it reaches — head turned to the
+//! object, arm out of the way, another view where one does not see it — and
+//! measures the object with its head cameras before it plans; the demo shows
+//! how far that measurement is from the truth, and plans on it.
 //!
 //! How: the error is taken modulo the object's symmetry as the component reports
 //! it: with a continuous axis (a can), where the axis point goes and where the
@@ -33,7 +36,7 @@ use std::time::{Duration, Instant};
 
 use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
 use serde::Serialize;
-use tsukami_msgs::vision::{DetectRequest, ObjectPose};
+use tsukami_msgs::vision::{LookReply, LookRequest, LookView, ObjectPose};
 use tsukami_msgs::Pose;
 use tsukami_scenes::geometry::{isometry_to_pose, pose_to_isometry};
 
@@ -59,7 +62,8 @@ pub struct VisionCheck {
     pub confidence: f64,
     /// RMS fit error, millimetres.
     pub fit_error_mm: f64,
-    /// Round trip of the detect request (render and detect), milliseconds.
+    /// Round trip of the look request (every view rendered and detected in),
+    /// milliseconds.
     pub detect_ms: f64,
     /// The reported pose.
     pub pose: Pose,
@@ -67,10 +71,15 @@ pub struct VisionCheck {
     /// the object's symmetry to the member nearest the scene file's
     /// ([`nearest_member`]).
     pub plan_pose: Pose,
+    /// The name of the view the object was found in.
+    pub view: String,
+    /// The views the look took, in order (the component's `views`).
+    pub views: Vec<LookView>,
 }
 
-/// Asks the vision component for `object` in a simulated frame (noise seeded by
-/// `seed`) and compares the answer with `truth`.
+/// Asks the vision component to look for `object` with its simulated head
+/// camera (noise seeded by `seed`), where its scene has it, and compares the
+/// answer with `truth`.
 pub fn detect(
     client: &BusClient,
     object: &str,
@@ -78,9 +87,10 @@ pub fn detect(
     seed: u64,
     timeout: Duration,
 ) -> Result<VisionCheck, String> {
-    let request = DetectRequest {
+    let request = LookRequest {
         object: object.to_owned(),
-        image: None,
+        expected: None,
+        max_views: None,
         set_object: false,
         min_confidence: None,
         seed: Some(seed),
@@ -88,11 +98,14 @@ pub fn detect(
     let payload = serde_json::to_vec(&request).map_err(|e| e.to_string())?;
     let start = Instant::now();
     let reply = client
-        .request_key(&client.keys().vision_detect(), &payload, timeout)
+        .request_key(&client.keys().vision_look(), &payload, timeout)
         .map_err(|e| e.to_string())?;
     let detect_ms = start.elapsed().as_secs_f64() * 1e3;
-    let found: ObjectPose =
+    let LookReply { pose: found, view, views } =
         serde_json::from_slice(&reply).map_err(|e| format!("vision reply: {e}"))?;
+    let view = views
+        .get(view as usize)
+        .map_or_else(|| format!("#{view}"), |v| v.name.clone());
     let (dist, angle) = pose_error(&found, truth)?;
     let angle_deg = angle.to_degrees();
     Ok(VisionCheck {
@@ -105,6 +118,8 @@ pub fn detect(
         detect_ms,
         pose: found.pose,
         plan_pose: nearest_member(&found, truth)?,
+        view,
+        views,
     })
 }
 
