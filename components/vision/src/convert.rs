@@ -19,8 +19,8 @@ use tsukami_msgs::vision::{
 use crate::camera::{Camera, Intrinsics};
 use crate::depth::{DepthEncoding, DepthImage};
 use crate::detect::{Detection, Outcome};
-use crate::look::Attempt;
 use crate::error::{invalid, Result};
+use crate::look::Attempt;
 use crate::symmetry::Symmetry;
 
 /// Largest base64 payload accepted for an image (bytes of text).
@@ -183,7 +183,12 @@ pub fn attempt_to_msg(a: &Attempt, robot: &RobotModel, rest: &[f64]) -> LookView
         .map(|(j, joint)| (joint.name.clone(), a.view.q[j]))
         .collect();
     let (found, confidence, occluded, reason) = match &a.outcome {
-        Outcome::Found(d) => (true, Some(d.confidence), Some(d.verdict.occluded_fraction()), None),
+        Outcome::Found(d) => (
+            true,
+            Some(d.confidence),
+            Some(d.verdict.occluded_fraction()),
+            None,
+        ),
         Outcome::NotFound(n) => (
             false,
             n.best.as_ref().map(|b| b.confidence),

@@ -120,8 +120,13 @@ impl VisionService {
                 )))
             }
         };
-        if req.expected.is_some_and(|p| !p.iter().all(|x| x.is_finite())) {
-            return Err(invalid_value("expected: must be three finite numbers (m)".into()));
+        if req
+            .expected
+            .is_some_and(|p| !p.iter().all(|x| x.is_finite()))
+        {
+            return Err(invalid_value(
+                "expected: must be three finite numbers (m)".into(),
+            ));
         }
         let seed = req.seed.unwrap_or(self.frames);
         self.frames += 1;
@@ -152,12 +157,21 @@ impl VisionService {
             .iter()
             .map(|a| attempt_to_msg(a, robot, &rest))
             .collect();
-        let shown = looked.chosen.or_else(|| most_confident(&looked)).unwrap_or(0);
+        let shown = looked
+            .chosen
+            .or_else(|| most_confident(&looked))
+            .unwrap_or(0);
         let outcome = looked.attempts.get(shown).map(|a| a.outcome.clone());
         let outcome = outcome.ok_or_else(|| {
             ErrorReply::new(ErrorCode::Infeasible, "no view of the object may be taken")
         })?;
-        answer(&req.object, req.set_object, &template, outcome, Some((shown as u32, views)))
+        answer(
+            &req.object,
+            req.set_object,
+            &template,
+            outcome,
+            Some((shown as u32, views)),
+        )
     }
 
     /// The detection settings of a request (its `min_confidence` checked) and
@@ -182,7 +196,10 @@ impl VisionService {
             }
             params.min_confidence = c;
         }
-        let template = self.detector.template(object).map_err(|e| error_reply(&e))?;
+        let template = self
+            .detector
+            .template(object)
+            .map_err(|e| error_reply(&e))?;
         Ok((params, template))
     }
 }
@@ -247,11 +264,13 @@ fn answer(
                 ),
                 None => (format!("'{object}' not found: {}", n.reason), None),
             };
-            Err(ErrorReply::new(ErrorCode::Infeasible, message).with_details(json!({
-                "reason": "not_found",
-                "best_confidence": n.best.as_ref().map(|b| b.confidence),
-                "views": views,
-            })))
+            Err(
+                ErrorReply::new(ErrorCode::Infeasible, message).with_details(json!({
+                    "reason": "not_found",
+                    "best_confidence": n.best.as_ref().map(|b| b.confidence),
+                    "views": views,
+                })),
+            )
         }
     }
 }

@@ -41,7 +41,11 @@ impl Looker {
             if hidden.hidden == 0 && colliding.is_empty() {
                 break;
             }
-            let links = hidden.by_link.iter().map(|&(l, _)| l).chain(colliding.iter().copied());
+            let links = hidden
+                .by_link
+                .iter()
+                .map(|&(l, _)| l)
+                .chain(colliding.iter().copied());
             let Some(j) = self.arm_joint(links, &moved) else {
                 break;
             };
@@ -74,7 +78,10 @@ impl Looker {
             }
             let h = self.hidden(&trial, target);
             let key = (h.hidden, (value - rest).abs());
-            if best.as_ref().is_none_or(|b| key.0 < b.0 .0 || (key.0 == b.0 .0 && key.1 < b.0 .1)) {
+            if best
+                .as_ref()
+                .is_none_or(|b| key.0 < b.0 .0 || (key.0 == b.0 .0 && key.1 < b.0 .1))
+            {
                 best = Some((key, value, h));
             }
         }

@@ -40,11 +40,16 @@
 //! let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/../../models/robots/tsukami_humanoid/tsukami_humanoid.urdf");
 //! let head = HeadCamera::new(load_urdf(Path::new(urdf)).unwrap(), Intrinsics::head_camera()).unwrap();
 //! let looker = Looker::new(head, Vec::new()).unwrap();
-//! // A can on a waist-high table, front right.
-//! let target = Target { centre: Point3::new(0.36, -0.25, 0.84), radius: 0.07 };
-//! let view = looker.view(&STANCES[0], &target).unwrap();
+//! // A can at breast height, front right: the head alone looks at it.
+//! let breast = Target { centre: Point3::new(0.52, -0.25, 1.16), radius: 0.067 };
+//! let view = looker.view(&STANCES[0], &breast).unwrap();
 //! assert_eq!(view.name, "aim");
 //! assert_eq!(view.hidden.hidden, 0, "nothing of the robot in front of the can");
+//! // At waist height the waist bends, until the chest is (nearly) out of the picture.
+//! let waist = Target { centre: Point3::new(0.36, -0.25, 0.84), radius: 0.067 };
+//! let view = looker.view(&STANCES[0], &waist).unwrap();
+//! assert!(view.q[looker.head.waist.unwrap()] > 0.5);
+//! assert!(view.hidden.fraction() < 0.05, "{:?}", view.hidden);
 //! ```
 
 pub mod arm;
@@ -105,12 +110,42 @@ pub struct Stance {
 
 /// The views of a look, in the order they are tried.
 pub const STANCES: [Stance; MAX_VIEWS] = [
-    Stance { name: "aim", lower: 0.0, turn: 0.0, lean: 0 },
-    Stance { name: "crouch", lower: 1.0, turn: 0.0, lean: 0 },
-    Stance { name: "crouch_lean", lower: 1.0, turn: 0.0, lean: 2 },
-    Stance { name: "lean", lower: 0.0, turn: 0.0, lean: 2 },
-    Stance { name: "turn_left", lower: 0.0, turn: 0.35, lean: 0 },
-    Stance { name: "turn_right", lower: 0.0, turn: -0.35, lean: 0 },
+    Stance {
+        name: "aim",
+        lower: 0.0,
+        turn: 0.0,
+        lean: 0,
+    },
+    Stance {
+        name: "crouch",
+        lower: 1.0,
+        turn: 0.0,
+        lean: 0,
+    },
+    Stance {
+        name: "crouch_lean",
+        lower: 1.0,
+        turn: 0.0,
+        lean: 2,
+    },
+    Stance {
+        name: "lean",
+        lower: 0.0,
+        turn: 0.0,
+        lean: 2,
+    },
+    Stance {
+        name: "turn_left",
+        lower: 0.0,
+        turn: 0.35,
+        lean: 0,
+    },
+    Stance {
+        name: "turn_right",
+        lower: 0.0,
+        turn: -0.35,
+        lean: 0,
+    },
 ];
 
 /// One view: a posture of the whole robot.

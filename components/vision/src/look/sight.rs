@@ -122,7 +122,8 @@ impl Looker {
             .zip(counts)
             .filter(|&(_, n)| n > 0)
             .collect();
-        out.by_link.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+        out.by_link
+            .sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
         out
     }
 }

@@ -205,7 +205,9 @@ fn body_joints(robot: &RobotModel, camera: LinkId, head: [JointId; 2]) -> [Optio
         if head.contains(&j) || !joint.is_independent() {
             continue;
         }
-        let up = (fk.pose(joint.child).rotation * joint.axis.into_inner()).z.abs();
+        let up = (fk.pose(joint.child).rotation * joint.axis.into_inner())
+            .z
+            .abs();
         let kind = match joint.kind {
             JointKind::Revolute | JointKind::Continuous if up < 0.3 => 0,
             JointKind::Revolute | JointKind::Continuous if up > 0.9 => 1,

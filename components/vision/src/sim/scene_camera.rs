@@ -98,7 +98,10 @@ impl SceneCamera {
                 self.scene.robot_base.inverse() * (o.pose * nalgebra::center(&lo, &hi))
             }
             None => {
-                let rest = self.looker.head.camera(&self.looker.head.robot.rest_positions());
+                let rest = self
+                    .looker
+                    .head
+                    .camera(&self.looker.head.robot.rest_positions());
                 rest.pose * Point3::new(0.0, 0.0, 1.0)
             }
         };

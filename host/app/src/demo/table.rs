@@ -210,7 +210,11 @@ mod tests {
         );
         assert!(row(&s).starts_with("can_breast "));
         s.plan_on = PlanOn::Scene;
-        assert_eq!(notes(&s).len(), 2, "asked for the scene file's pose: no fallback");
+        assert_eq!(
+            notes(&s).len(),
+            2,
+            "asked for the scene file's pose: no fallback"
+        );
     }
 
     fn view(name: &str, confidence: Option<f64>, found: bool) -> LookView {

@@ -101,8 +101,11 @@ pub fn detect(
         .request_key(&client.keys().vision_look(), &payload, timeout)
         .map_err(|e| e.to_string())?;
     let detect_ms = start.elapsed().as_secs_f64() * 1e3;
-    let LookReply { pose: found, view, views } =
-        serde_json::from_slice(&reply).map_err(|e| format!("vision reply: {e}"))?;
+    let LookReply {
+        pose: found,
+        view,
+        views,
+    } = serde_json::from_slice(&reply).map_err(|e| format!("vision reply: {e}"))?;
     let view = views
         .get(view as usize)
         .map_or_else(|| format!("#{view}"), |v| v.name.clone());
@@ -141,7 +144,12 @@ impl Members {
                 motions.push(pose_to_isometry(pose).map_err(|e| format!("symmetry: {e}"))?);
             }
         }
-        let axis = axis.map(|a| (Point3::from(a.point), Vector3::from(a.direction).normalize()));
+        let axis = axis.map(|a| {
+            (
+                Point3::from(a.point),
+                Vector3::from(a.direction).normalize(),
+            )
+        });
         Ok(Members {
             estimate,
             motions,
@@ -294,11 +302,17 @@ mod tests {
         let found = seen(seen_pose, Some(axis));
         let member = nearest_member(&found, &truth).unwrap();
         // Only the tilt is left against the truth, and the error is unchanged.
-        let (m, t) = (pose_to_isometry(&member).unwrap(), pose_to_isometry(&truth).unwrap());
+        let (m, t) = (
+            pose_to_isometry(&member).unwrap(),
+            pose_to_isometry(&truth).unwrap(),
+        );
         assert!((m.rotation.angle_to(&t.rotation) - 0.02).abs() < 1e-9);
         let (d0, a0) = pose_error(&found, &truth).unwrap();
         let (d1, a1) = pose_error(&seen(member, found.symmetry.clone()), &truth).unwrap();
-        assert!((d0 - d1).abs() < 1e-12 && (a0 - a1).abs() < 1e-12, "{d0} {d1} {a0} {a1}");
+        assert!(
+            (d0 - d1).abs() < 1e-12 && (a0 - a1).abs() < 1e-12,
+            "{d0} {d1} {a0} {a1}"
+        );
         // Without a symmetry, the pose is what was seen.
         let plain = nearest_member(&seen(seen_pose, None), &truth).unwrap();
         assert_eq!(plain.position, seen_pose.position);
