@@ -194,6 +194,7 @@ fn garbage_cases(keys: &KeySpace) -> Vec<Case> {
         keys.controller_stop(),
         keys.controller_state(),
         keys.vision_detect(),
+        keys.vision_look(),
         keys.component_info("controller"),
         keys.host_plugins(),
     ];
@@ -257,7 +258,8 @@ fn controller_cases(keys: &KeySpace) -> Vec<Case> {
 }
 
 /// Depth frames that lie about their size, data or camera; objects that are not
-/// models.
+/// models; looks at the far end of the world, inside the robot, or with views
+/// out of bounds.
 fn vision_cases(keys: &KeySpace) -> Vec<Case> {
     let camera = |w: u64, h: u64, f: f64| {
         serde_json::json!({"intrinsics": {"width": w, "height": h, "fx": f, "fy": f, "cx": 1.0, "cy": 1.0},
@@ -275,16 +277,19 @@ fn vision_cases(keys: &KeySpace) -> Vec<Case> {
         serde_json::json!({"object": "x".repeat(1 << 20)}),
         serde_json::json!({"object": "can_350ml", "min_confidence": -1.0, "seed": u64::MAX}),
     ];
-    requests
-        .into_iter()
+    let looks = [
+        serde_json::json!({"object": "can_350ml", "expected": [1e308, 1e308, 1e308], "max_views": 2}),
+        serde_json::json!({"object": "can_350ml", "expected": [0, 0, 0], "max_views": 2}),
+        serde_json::json!({"object": "can_350ml", "expected": [1, 2]}),
+        serde_json::json!({"object": "can_350ml", "max_views": u32::MAX}),
+        serde_json::json!({"object": "../../etc/passwd", "max_views": 0}),
+    ];
+    let detects = requests.into_iter().map(|r| ("detect", keys.vision_detect(), r));
+    let looks = looks.into_iter().map(|r| ("look", keys.vision_look(), r));
+    detects
+        .chain(looks)
         .enumerate()
-        .map(|(i, r)| {
-            (
-                format!("detect {i}"),
-                keys.vision_detect(),
-                r.to_string().into_bytes(),
-            )
-        })
+        .map(|(i, (what, key, r))| (format!("{what} {i}"), key, r.to_string().into_bytes()))
         .collect()
 }
 

@@ -150,6 +150,17 @@ fn the_expected_position_steers_the_head_and_bad_requests_are_named() {
     };
     let err = vision.look(&elsewhere).unwrap_err();
     assert_eq!(err.error.details.unwrap()["reason"], "not_found");
+    // At the far end of the world, inside the robot's own base: answered.
+    for far in [[1e308, 1e308, 1e308], [0.0, 0.0, 0.0]] {
+        let odd = LookRequest {
+            expected: Some(far),
+            max_views: Some(2),
+            ..there.clone()
+        };
+        if let Err(e) = vision.look(&odd) {
+            assert_eq!(e.error.code, ErrorCode::Infeasible, "{far:?}: {e:?}");
+        }
+    }
     for (bad, field) in [
         (
             LookRequest {

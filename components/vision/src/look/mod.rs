@@ -211,25 +211,22 @@ impl Looker {
     pub fn new(head: HeadCamera, obstacles: Vec<CollisionObject>) -> Result<Self> {
         let collision = RobotCollision::new(&head.robot)?;
         let rest = head.robot.rest_positions();
-        let mut looker = Looker {
+        let mut fk = FkState::new(&head.robot);
+        head.robot.forward_kinematics(&rest, &mut fk);
+        let rest_self_collisions = collision.self_collisions(&fk, 0.0);
+        Ok(Looker {
             head,
             collision,
             obstacles,
-            rest_self_collisions: Vec::new(),
             rest,
-        };
-        looker.rest_self_collisions = looker.self_collisions(&looker.rest.clone());
-        Ok(looker)
+            rest_self_collisions,
+        })
     }
 
     fn fk(&self, q: &[f64]) -> FkState {
         let mut fk = FkState::new(&self.head.robot);
         self.head.robot.forward_kinematics(q, &mut fk);
         fk
-    }
-
-    fn self_collisions(&self, q: &[f64]) -> Vec<(LinkId, LinkId)> {
-        self.collision.self_collisions(&self.fk(q), 0.0)
     }
 
     /// Whether the robot may take posture `q`: no link sunk into a known
