@@ -194,6 +194,7 @@ fn garbage_cases(keys: &KeySpace) -> Vec<Case> {
         keys.controller_stop(),
         keys.controller_state(),
         keys.vision_detect(),
+        keys.vision_look(),
         keys.component_info("controller"),
         keys.host_plugins(),
     ];
@@ -257,7 +258,7 @@ fn controller_cases(keys: &KeySpace) -> Vec<Case> {
 }
 
 /// Depth frames that lie about their size, data or camera; objects that are not
-/// models.
+/// models; looks at no point or with views out of bounds.
 fn vision_cases(keys: &KeySpace) -> Vec<Case> {
     let camera = |w: u64, h: u64, f: f64| {
         serde_json::json!({"intrinsics": {"width": w, "height": h, "fx": f, "fy": f, "cx": 1.0, "cy": 1.0},
@@ -275,16 +276,26 @@ fn vision_cases(keys: &KeySpace) -> Vec<Case> {
         serde_json::json!({"object": "x".repeat(1 << 20)}),
         serde_json::json!({"object": "can_350ml", "min_confidence": -1.0, "seed": u64::MAX}),
     ];
-    requests
+    // Refused before anything is rendered (a look at a far or odd point is
+    // answered too, components/vision/tests/look.rs, but renders and detects in
+    // up to six views: longer than a case may take in a debug build).
+    let looks = [
+        r#"{"object": "can_350ml", "expected": [1e309, 0, 0]}"#,
+        r#"{"object": "can_350ml", "expected": [1, 2]}"#,
+        r#"{"object": "can_350ml", "max_views": 4294967295}"#,
+        r#"{"object": "can_350ml", "max_views": 4294967296}"#,
+        r#"{"object": "../../etc/passwd", "max_views": 0}"#,
+    ];
+    let detects = requests
         .into_iter()
+        .map(|r| ("detect", keys.vision_detect(), r.to_string()));
+    let looks = looks
+        .into_iter()
+        .map(|r| ("look", keys.vision_look(), r.to_owned()));
+    detects
+        .chain(looks)
         .enumerate()
-        .map(|(i, r)| {
-            (
-                format!("detect {i}"),
-                keys.vision_detect(),
-                r.to_string().into_bytes(),
-            )
-        })
+        .map(|(i, (what, key, r))| (format!("{what} {i}"), key, r.into_bytes()))
         .collect()
 }
 

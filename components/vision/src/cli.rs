@@ -1,10 +1,11 @@
 //! The command line of `tsukami-vision`.
 //!
-//! - `serve`: the component on the bus (answers `<ns>/vision/detect`,
-//!   publishes `<ns>/vision/pose/<object>`), with the simulated head camera
-//!   of `--scene` when requests carry no image.
+//! - `serve`: the component on the bus (answers `<ns>/vision/detect` and
+//!   `<ns>/vision/look`, publishes `<ns>/vision/pose/<object>`), with the
+//!   simulated head camera of `--scene` when requests carry no image.
 //! - `render`: a simulated depth frame of a scene to files (a 16-bit PNG in
-//!   millimetres, or float32 for any other extension, and the camera as JSON).
+//!   millimetres, or float32 for any other extension, and the camera as JSON),
+//!   seen from the first view of a look at the object.
 //! - `detect`: the pose of an object in a depth file, printed as JSON.
 
 use std::path::{Path, PathBuf};
@@ -78,7 +79,8 @@ enum Command {
         /// The scene file.
         #[arg(long)]
         scene: PathBuf,
-        /// Look at this object (model or scene name; default: the first).
+        /// Look at this object (model or scene name; default: the first), from
+        /// the first view of a look: head aimed, body and arms out of the view.
         #[arg(long, default_value = "")]
         object: String,
         /// Noise seed.
@@ -152,10 +154,10 @@ fn run(command: Command) -> anyhow::Result<i32> {
                 &bus,
             )?;
             let timeout = Duration::from_secs_f64(set_object_timeout.clamp(0.1, 600.0));
-            let (queryable, worker) = serve(&component, service, timeout)?;
+            let (queryables, worker) = serve(&component, service, timeout)?;
             shutdown.wait();
             tracing::info!("shutting down");
-            drop(queryable);
+            drop(queryables);
             component.close();
             let _ = worker.join();
             Ok(0)

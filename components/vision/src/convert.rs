@@ -1,23 +1,26 @@
 //! Between bus messages ([`tsukami_msgs::vision`]) and the library's types.
 //!
 //! What: cameras, depth frames (base64 payloads), poses and detections in
-//! both directions, each checked, with errors naming the field.
+//! both directions, each checked, with errors naming the field; the views of
+//! a look out to the reply.
 //!
 //! Why: the bus speaks JSON with quaternions `[x, y, z, w]` and base64
 //! images; the pipeline speaks nalgebra and [`DepthImage`].
 
 use base64::Engine;
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
+use tsukami_body::model::RobotModel;
 use tsukami_msgs::common::Pose;
 use tsukami_msgs::vision::{
-    CameraInfo, CameraIntrinsics, DepthEncoding as MsgEncoding, DepthFrame, ObjectPose,
+    CameraInfo, CameraIntrinsics, DepthEncoding as MsgEncoding, DepthFrame, LookView, ObjectPose,
     Symmetry as MsgSymmetry, SymmetryAxis,
 };
 
 use crate::camera::{Camera, Intrinsics};
 use crate::depth::{DepthEncoding, DepthImage};
-use crate::detect::Detection;
+use crate::detect::{Detection, Outcome};
 use crate::error::{invalid, Result};
+use crate::look::Attempt;
 use crate::symmetry::Symmetry;
 
 /// Largest base64 payload accepted for an image (bytes of text).
@@ -166,5 +169,41 @@ pub fn detection_to_msg(d: &Detection, sym: &Symmetry) -> ObjectPose {
         occluded: d.verdict.occluded_fraction(),
         symmetry: symmetry_to_msg(sym),
         sent_to: None,
+    }
+}
+
+/// A view a look took, with what it saw, as the reply message: the joints
+/// of the posture away from `rest`, by name.
+pub fn attempt_to_msg(a: &Attempt, robot: &RobotModel, rest: &[f64]) -> LookView {
+    let joints = robot
+        .joints
+        .iter()
+        .enumerate()
+        .filter(|(j, joint)| joint.is_movable() && (a.view.q[*j] - rest[*j]).abs() > 1e-9)
+        .map(|(j, joint)| (joint.name.clone(), a.view.q[j]))
+        .collect();
+    let (found, confidence, occluded, reason) = match &a.outcome {
+        Outcome::Found(d) => (
+            true,
+            Some(d.confidence),
+            Some(d.verdict.occluded_fraction()),
+            None,
+        ),
+        Outcome::NotFound(n) => (
+            false,
+            n.best.as_ref().map(|b| b.confidence),
+            None,
+            Some(n.reason.clone()),
+        ),
+    };
+    LookView {
+        name: a.view.name.to_owned(),
+        joints,
+        camera_pose: pose_to_msg(&a.view.camera.pose),
+        self_hidden: a.view.hidden.fraction(),
+        found,
+        confidence,
+        occluded,
+        reason,
     }
 }

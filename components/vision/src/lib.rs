@@ -35,6 +35,7 @@ pub mod error;
 pub mod freespace;
 pub mod hypotheses;
 pub mod icp;
+pub mod look;
 pub mod lookup;
 pub mod plane;
 pub mod resting;

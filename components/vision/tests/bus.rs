@@ -1,6 +1,7 @@
 //! The component as a separate process on a real zenoh bus (loopback): info,
 //! detect with its simulated camera, the published pose, set_object sent on to
-//! the world, error replies (oversized payloads too), and a clean exit on SIGTERM.
+//! the world, error replies (oversized payloads too), and a clean exit on
+//! SIGTERM; a look in the fridge scene, its views in the reply.
 
 use std::process::{Child, Command, Stdio};
 use std::sync::{Arc, Mutex};
@@ -9,7 +10,7 @@ use std::time::{Duration, Instant};
 use tsukami_bus::serve::reply_json;
 use tsukami_bus::{free_loopback_port, BusClient, BusConfig, RequestError};
 use tsukami_msgs::planner::SetObject;
-use tsukami_msgs::vision::ObjectPose;
+use tsukami_msgs::vision::{LookReply, ObjectPose};
 use tsukami_msgs::ErrorCode;
 use zenoh::Wait;
 
@@ -22,20 +23,81 @@ impl Drop for Process {
     }
 }
 
-#[test]
-fn vision_component_over_the_bus() {
+/// The component serving `extra` arguments on a free loopback port under a
+/// namespace named after `name`, and a client connected to it.
+fn start(name: &str, extra: &[&str]) -> (Process, BusClient, String) {
     let port = free_loopback_port().unwrap();
     let endpoint = format!("tcp/127.0.0.1:{port}");
-    let ns = format!("test-vision-{}", std::process::id());
-    let mut child = Process(
+    let ns = format!("test-{name}-{}", std::process::id());
+    let child = Process(
         Command::new(env!("CARGO_BIN_EXE_tsukami-vision"))
             .args(["serve", "--listen", &endpoint, "--namespace", &ns])
+            .args(extra)
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .spawn()
             .unwrap(),
     );
     let client = BusClient::connect(&BusConfig::connecting(&endpoint), &ns).unwrap();
+    (child, client, ns)
+}
+
+#[test]
+fn a_look_over_the_bus_answers_its_views() {
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../models/scenes/fridge_pet.toml"
+    );
+    let (_child, client, ns) = start("vision-look", &["--scene", scene]);
+    let info = client
+        .wait_for_component("vision", Duration::from_secs(60))
+        .unwrap();
+    assert!(
+        info.keys.contains(&format!("{ns}/vision/look")),
+        "{:?}",
+        info.keys
+    );
+    let poses = client
+        .session()
+        .declare_subscriber(format!("{ns}/vision/pose/pet_500ml"))
+        .wait()
+        .unwrap();
+    let reply = client
+        .request_key(
+            &format!("{ns}/vision/look"),
+            br#"{"object": "pet_500ml", "seed": 0}"#,
+            Duration::from_secs(120),
+        )
+        .unwrap();
+    let look: LookReply = serde_json::from_slice(&reply).unwrap();
+    // The bottle on the lower shelf at (0.58, -0.25, 0.33), seen crouched.
+    let p = look.pose.pose.position;
+    assert!(
+        (p[0] - 0.58).abs() < 0.005 && (p[1] + 0.25).abs() < 0.005 && (p[2] - 0.33).abs() < 0.005,
+        "{p:?}"
+    );
+    assert!(
+        look.views.len() > 1 && !look.views[0].found,
+        "{:?}",
+        look.views
+    );
+    let seen = &look.views[look.view as usize];
+    assert!(
+        seen.found && seen.joints.contains_key("squat_z"),
+        "{seen:?}"
+    );
+    let published = poses
+        .recv_timeout(Duration::from_secs(10))
+        .unwrap()
+        .expect("a published pose");
+    let published: ObjectPose = serde_json::from_slice(&published.payload().to_bytes()).unwrap();
+    assert_eq!(published, look.pose);
+    client.close();
+}
+
+#[test]
+fn vision_component_over_the_bus() {
+    let (mut child, client, ns) = start("vision", &[]);
     let info = client
         .wait_for_component("vision", Duration::from_secs(60))
         .unwrap();
@@ -69,6 +131,12 @@ fn vision_component_over_the_bus() {
         .declare_subscriber(format!("{ns}/vision/pose/can_350ml"))
         .wait()
         .unwrap();
+
+    assert!(
+        info.keys.contains(&format!("{ns}/vision/look")),
+        "{:?}",
+        info.keys
+    );
 
     // The can of models/scenes/can_breast.toml (the default scene) stands at (0.52, -0.25, 1.10).
     let key = format!("{ns}/vision/detect");

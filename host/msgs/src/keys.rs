@@ -134,6 +134,12 @@ impl KeySpace {
         self.key("vision/detect")
     }
 
+    /// `<ns>/vision/look`: ask the vision component to look for an object with
+    /// the robot's head camera.
+    pub fn vision_look(&self) -> String {
+        self.key("vision/look")
+    }
+
     /// `<ns>/vision/pose/<object>`: the vision component's pose stream of an object.
     pub fn vision_pose(&self, object: &str) -> String {
         self.key(&format!("vision/pose/{object}"))
@@ -190,6 +196,7 @@ mod tests {
         assert_eq!(ks.host_plugins(), "tsukami/host/plugins");
         assert_eq!(ks.world(planner::SET_OBJECT), "tsukami/world/set_object");
         assert_eq!(ks.vision_pose("can"), "tsukami/vision/pose/can");
+        assert_eq!(ks.vision_look(), "tsukami/vision/look");
         assert_eq!(ks.controller_stop(), "tsukami/controller/stop");
         assert_eq!(ks.component_info("vision"), "tsukami/vision/info");
         assert_eq!(ks.component_info_all(), "tsukami/*/info");

@@ -39,6 +39,8 @@ pub fn all() -> Vec<NamedSchema> {
         named::<crate::component::ComponentInfo>("component_info"),
         named::<crate::vision::DetectRequest>("vision_detect_request"),
         named::<crate::vision::ObjectPose>("vision_object_pose"),
+        named::<crate::vision::LookRequest>("vision_look_request"),
+        named::<crate::vision::LookReply>("vision_look_reply"),
         named::<crate::planner::SetRobot>("planner_set_robot_request"),
         named::<crate::planner::RobotSummary>("planner_set_robot_reply"),
         named::<crate::planner::SetObject>("planner_set_object_request"),

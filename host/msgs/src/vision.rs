@@ -5,6 +5,15 @@
 //! is not in the image (a wrong or absent object is never reported as a
 //! confident pose), `invalid_value` for a bad image or camera. A found pose is
 //! also published on `<ns>/vision/pose/<object>`.
+//!
+//! `<ns>/vision/look` takes a [`LookRequest`] and answers a [`LookReply`]: the
+//! component looks for the object with the robot's head camera — head aimed
+//! where it is expected, the arms and the body out of the view, other views
+//! (crouched, leaning, turned) where one does not see it — and answers the
+//! pose with the views it took. A detect request without an image looks the
+//! same way and answers the pose alone.
+
+use std::collections::BTreeMap;
 
 use crate::common::Pose;
 use schemars::JsonSchema;
@@ -30,6 +39,72 @@ pub struct DetectRequest {
     /// Seed of a simulated frame's noise (default: the component's frame counter).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
+}
+
+/// Request of `<ns>/vision/look`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LookRequest {
+    /// The object model to look for (a name from `models/objects`).
+    pub object: String,
+    /// Where the object is expected: a point of it, its centre roughly, in the
+    /// robot's base frame (m). The head is aimed there. Default: where the
+    /// component's world has it (the simulated camera's scene file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub expected: Option<[f64; 3]>,
+    /// The most views to take, 1 to 6 (default 6).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_views: Option<u32>,
+    /// Send a found pose on as the object's pose, as in `DetectRequest`.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub set_object: bool,
+    /// Report a pose only at this confidence or more (default: the component's, 0.8).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_confidence: Option<f64>,
+    /// Seed of the simulated frames' noise (default: the component's frame counter).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+}
+
+/// Reply of `<ns>/vision/look`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LookReply {
+    /// The object as found (what `<ns>/vision/detect` replies).
+    pub pose: ObjectPose,
+    /// The index in `views` of the view it was found in.
+    pub view: u32,
+    /// The views taken, in order.
+    pub views: Vec<LookView>,
+}
+
+/// One view a look took: the robot's posture and what the camera saw.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LookView {
+    /// The kind of view: `aim`, `crouch`, `lean`, `turn_left`, `turn_right`,
+    /// `crouch_lean`.
+    pub name: String,
+    /// The joints of the posture away from rest: name → position (rad, or m
+    /// for a prismatic joint).
+    pub joints: BTreeMap<String, f64>,
+    /// Pose of the camera's optical frame in the robot's base frame.
+    pub camera_pose: Pose,
+    /// Fraction of the object's part of the image (its bounding sphere grown
+    /// 1.5 times) that the robot's own links hide: 0 when the arms and the
+    /// body are out of the view.
+    pub self_hidden: f64,
+    /// Whether the object was found in this view.
+    pub found: bool,
+    /// The detection's confidence, or its best candidate's when not found.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub confidence: Option<f64>,
+    /// Fraction of the found object's visible surface hidden by something in front.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub occluded: Option<f64>,
+    /// Why it was not found.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
 }
 
 /// A depth image with the camera that took it.

@@ -4,6 +4,7 @@
 //! What: [`surface_point`] returns the distance from a point to a closed mesh's
 //! surface and the outward normals of every triangle that holds the closest
 //! point (one for a face, two along an edge, the whole fan at a vertex);
+//! [`surface_point_within`] those of every triangle within a radius of it;
 //! [`angle_to_normal_cone`] measures how far a direction is from the cone those
 //! normals span.
 //!
@@ -41,9 +42,9 @@ use tsukami_body::capsule_mesh::closest_point_on_triangle;
 use tsukami_body::convert::{to_point, to_vec};
 use tsukami_body::mesh::TriangleMesh;
 
-/// Triangles whose closest point is within this distance (m) of the overall
-/// closest point are taken to hold it (they share the closest edge or vertex).
-const SAME_POINT: f64 = 1e-7;
+/// Triangles within this distance (m) of the overall closest point are taken
+/// to hold it (they share the closest edge or vertex).
+pub const SAME_POINT: f64 = 1e-7;
 
 /// The closest point of a mesh's surface to a query point.
 #[derive(Debug, Clone, PartialEq)]
@@ -59,27 +60,37 @@ pub struct SurfacePoint {
 /// The closest surface point of `mesh` to `p` (both in the mesh's frame);
 /// `None` for a mesh without triangles or a non-finite point.
 pub fn surface_point(mesh: &TriangleMesh, p: &Point3<f64>) -> Option<SurfacePoint> {
+    surface_point_within(mesh, p, SAME_POINT)
+}
+
+/// [`surface_point`], with `normals` the outward normals of every triangle
+/// within `radius` (m) of the closest point: those holding it and, for a
+/// radius above [`SAME_POINT`], the surface around it (an edge that close).
+pub fn surface_point_within(
+    mesh: &TriangleMesh,
+    p: &Point3<f64>,
+    radius: f64,
+) -> Option<SurfacePoint> {
     if !p.coords.iter().all(|x| x.is_finite()) {
         return None;
     }
-    let closest: Vec<(f64, Point3<f64>)> = (0..mesh.indices.len())
-        .map(|k| {
-            let [a, b, c] = mesh.triangle(k);
-            let q = to_point(closest_point_on_triangle(
-                to_vec(p),
-                to_vec(&a),
-                to_vec(&b),
-                to_vec(&c),
-            ));
-            ((q - p).norm(), q)
-        })
-        .collect();
-    let (best, point) = closest.iter().copied().min_by(|a, b| a.0.total_cmp(&b.0))?;
-    let normals = closest
-        .iter()
-        .enumerate()
-        .filter(|(_, (_, q))| (q - point).norm() <= SAME_POINT)
-        .map(|(k, _)| mesh.triangle_normal(k))
+    let closest_on = |k: usize, to: &Point3<f64>| {
+        let [a, b, c] = mesh.triangle(k);
+        let q = to_point(closest_point_on_triangle(
+            to_vec(to),
+            to_vec(&a),
+            to_vec(&b),
+            to_vec(&c),
+        ));
+        ((q - to).norm(), q)
+    };
+    let (best, point) = (0..mesh.indices.len())
+        .map(|k| closest_on(k, p))
+        .min_by(|a, b| a.0.total_cmp(&b.0))?;
+    let radius = radius.max(SAME_POINT);
+    let normals = (0..mesh.indices.len())
+        .filter(|&k| closest_on(k, &point).0 <= radius)
+        .map(|k| mesh.triangle_normal(k))
         .filter(|n| n.iter().all(|x| x.is_finite()))
         .collect();
     Some(SurfacePoint {
@@ -178,6 +189,21 @@ mod tests {
         let tilted = Vector3::new(10f64.to_radians().sin(), 0.0, 10f64.to_radians().cos());
         let t = angle_to_normal_cone(&tilted, &above.normals);
         assert!((t - 10f64.to_radians()).abs() < 1e-9, "{t}");
+    }
+
+    #[test]
+    fn a_radius_takes_in_an_edge_that_close() {
+        let cube = TriangleMesh::cuboid(Vector3::new(0.2, 0.2, 0.2));
+        // On the top face, 0.5 mm from its +x edge.
+        let beside = Point3::new(0.0995, 0.0, 0.1);
+        let exact = surface_point(&cube, &beside).unwrap();
+        let x = Vector3::x();
+        assert!(angle_to_normal_cone(&x, &exact.normals) > 1.5);
+        let within = surface_point_within(&cube, &beside, 1e-3).unwrap();
+        assert_eq!(within.point, exact.point);
+        assert!(angle_to_normal_cone(&x, &within.normals) < 1e-9);
+        // The -x side is 0.2 m away: never taken in.
+        assert!(angle_to_normal_cone(&-x, &within.normals) > 1.5);
     }
 
     #[test]

@@ -22,7 +22,9 @@
 //!   alone);
 //! - **contacts on the object**: each contact within [`Tolerances::surface`] of the
 //!   object's surface, its normal within [`Tolerances::normal_angle`] of the
-//!   surface's (inward) normal cone there, and its link within
+//!   (inward) normal cone of the surface there — within
+//!   [`Tolerances::normal_radius`] of the contact's closest surface point —
+//!   and its link within
 //!   [`Tolerances::contact_gap`] of the point;
 //! - **no link sunk into anything**: forward kinematics at the reply's joint
 //!   positions, then every robot link against the object and every obstacle:
@@ -77,7 +79,7 @@ use tsukami_msgs::planner::DisturbanceSet;
 use tsukami_msgs::planner::{ContactReply, PlanReply};
 
 use crate::geometry::pose_to_isometry;
-use crate::surface::{angle_to_normal_cone, surface_point};
+use crate::surface::{angle_to_normal_cone, surface_point_within};
 use crate::world::World;
 
 /// Largest disagreement (rad or m) between a reported mimic joint and the value
@@ -96,6 +98,14 @@ pub struct Tolerances {
     /// Largest angle (rad) between a contact normal and the surface's inward
     /// normal cone at the contact. 5°.
     pub normal_angle: f64,
+    /// How much surface around a contact's closest surface point spans that
+    /// normal cone (m). 1 mm, as `surface`: a contact is placed to within a
+    /// millimetre, and so is the surface it presses on — an edge that close
+    /// is where it touches, and any direction of the edge's cone is its
+    /// normal. (With an exact point only, a grasp planned on an estimated pose
+    /// a fraction of a millimetre off fails wherever a fingertip was planned
+    /// on an edge: the point falls beside it, on one face.)
+    pub normal_radius: f64,
     /// Largest distance (m) from a contact's link to its contact point. 3 mm
     /// (the planners close fingers to within 2 mm).
     pub contact_gap: f64,
@@ -121,6 +131,7 @@ impl Default for Tolerances {
         Self {
             surface: 1e-3,
             normal_angle: 5f64.to_radians(),
+            normal_radius: 1e-3,
             contact_gap: 3e-3,
             penetration: 1e-3,
             palm_position: 1e-3,
@@ -525,7 +536,7 @@ fn check_contacts(
     for c in &reply.contacts {
         let p = Point3::from(c.position);
         let n = Vector3::from(c.normal);
-        match surface_point(&o.mesh, &(to_object * p)) {
+        match surface_point_within(&o.mesh, &(to_object * p), tol.normal_radius) {
             Some(s) if s.distance <= tol.surface => {
                 // Inward contact normal → outward, in the object frame.
                 let outward = -(to_object.rotation * n);

@@ -19,7 +19,7 @@ use parry3d_f64::shape::SharedShape;
 use tsukami_body::collision::{CollisionObject, Part, RobotCollision};
 use tsukami_body::convert::{to_pose, to_vec};
 use tsukami_body::kinematics::FkState;
-use tsukami_body::model::RobotModel;
+use tsukami_body::model::{LinkId, RobotModel};
 
 use crate::error::Result;
 
@@ -87,6 +87,21 @@ impl SimWorld {
         camera: &Point3<f64>,
     ) -> Result<()> {
         let collision = RobotCollision::new(robot)?;
+        self.add_robot_shapes(robot, &collision, q, base, camera);
+        Ok(())
+    }
+
+    /// [`SimWorld::add_robot`] with the link shapes already built; returns
+    /// the link of each body added, in order.
+    pub fn add_robot_shapes(
+        &mut self,
+        robot: &RobotModel,
+        collision: &RobotCollision,
+        q: &[f64],
+        base: &Isometry3<f64>,
+        camera: &Point3<f64>,
+    ) -> Vec<LinkId> {
+        let mut added = Vec::new();
         let mut fk = FkState::new(robot);
         fk.base = *base;
         robot.forward_kinematics(q, &mut fk);
@@ -107,9 +122,10 @@ impl SimWorld {
                     name: info.name.clone(),
                     shapes,
                 });
+                added.push(link);
             }
         }
-        Ok(())
+        added
     }
 
     /// The index of the body named `name`.

@@ -4,12 +4,14 @@
 //! planner) on a free loopback port, and for each of the paper's scenes the vision
 //! and controller components as child processes on the same bus; then, per scene,
 //! like any client would:
-//! 1. **vision**: `<ns>/vision/detect` finds the object in a frame of the simulated
-//!    head camera rendering the scene; its pose is compared with the scene file's;
-//! 2. **grasp**: SetRobot / SetObject / SetEnv / Plan with the scene file's object
-//!    pose (the truth, so the paper's outcomes are checked on the paper's scenes;
-//!    the vision error is reported beside them) or, with `--plan-on vision`, the
-//!    pose the vision saw; judged against the paper on the scene file's object;
+//! 1. **vision**: `<ns>/vision/look` finds the object with the simulated head
+//!    camera rendering the scene — the head aimed at it, the body and arms out of
+//!    the view, other views (crouched, leaning, turned) where one does not see
+//!    it; its pose is compared with the scene file's;
+//! 2. **grasp**: SetRobot / SetObject / SetEnv / Plan with the pose the vision saw
+//!    (the default, `--plan-on vision`; the scene file's where it did not find
+//!    the object) or, with `--plan-on scene`, the scene file's object pose (the
+//!    truth); judged against the paper on the scene file's object either way;
 //! 3. **motion**: `<ns>/motion/plan` from the controller's state (rest) to the
 //!    grasp and on to the lift;
 //! 4. **execution**: the controller runs it; the state it publishes at the end of
@@ -82,10 +84,11 @@ pub struct DemoArgs {
     /// How much faster than real time the controller executes (1 = real time).
     #[arg(long, default_value_t = 10.0)]
     pub speed: f64,
-    /// The object pose the grasp is planned on: the scene file's (`scene`), or
-    /// where the vision component saw it (`vision`; the scene file's when it did
-    /// not find it). Either way the grasp is judged on the scene file's object.
-    #[arg(long, value_enum, default_value_t = PlanOn::Scene)]
+    /// The object pose the grasp is planned on: where the vision component saw
+    /// it (`vision`; the scene file's when it did not find it, said in the
+    /// table), or the scene file's (`scene`). Either way the grasp is judged on
+    /// the scene file's object.
+    #[arg(long, value_enum, default_value_t = PlanOn::Vision)]
     pub plan_on: PlanOn,
     /// Folder holding the component binaries (`tsukami-vision`,
     /// `tsukami-controller`). Default: the `tsukami` binary's own folder.
@@ -101,7 +104,7 @@ impl Default for DemoArgs {
             json: false,
             out: None,
             speed: 10.0,
-            plan_on: PlanOn::Scene,
+            plan_on: PlanOn::Vision,
             components_dir: None,
         }
     }
@@ -289,7 +292,7 @@ impl Demo<'_> {
         }
         println!("{}", match self.args.plan_on {
             PlanOn::Scene => "Grasps are planned on each scene file's object pose; the vision error is measured against it.",
-            PlanOn::Vision => "Grasps are planned where the vision saw the object (on the scene file's pose where it did not find it); judged on the scene file's.",
+            PlanOn::Vision => "The vision looks for each object (head aimed, arms and body out of the view, other views where one does not see it); grasps are planned where it saw the object (on the scene file's pose where it did not find it); judged on the scene file's.",
         });
         println!("\n{}", table::header());
     }
@@ -365,7 +368,7 @@ impl Demo<'_> {
         let vision = self.vision(name, &file, &vision_process);
         drop(vision_process);
         let seen = match (&vision.data, vision.status, self.args.plan_on) {
-            (Some(v), StepStatus::Ok, PlanOn::Vision) => Some(v.pose),
+            (Some(v), StepStatus::Ok, PlanOn::Vision) => Some(v.plan_pose),
             _ => None,
         };
         let planned_on = if seen.is_some() {
@@ -379,6 +382,7 @@ impl Demo<'_> {
         let (motion, execution) = self.motion(&plan, &controller);
         DemoScene {
             plan,
+            plan_on: self.args.plan_on,
             planned_on,
             vision,
             motion,
@@ -398,7 +402,7 @@ impl Demo<'_> {
         let ObjectShape::Model { name: object } = &requests.object.shape else {
             return Step::not_run("the scene's object is not a model the vision knows");
         };
-        self.status.step(scene, "vision: finding the object");
+        self.status.step(scene, "vision: looking for the object");
         let truth = &requests.object.pose;
         Step::from_result(vision::detect(
             &self.client,

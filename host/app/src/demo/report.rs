@@ -38,8 +38,9 @@ pub fn write_report(dir: &Path, models: &Path, scenes: &[DemoScene], seed: u64) 
     };
     let mut md = format!(
         "# Tsukami demo report\n\nThe paper's scenes run over the bus (seed {seed}): the \
-         vision component finds the object (error against the scene file's pose), the grasp \
-         planner plans {planned_on}, the trajectory planner plans rest → grasp → \
+         vision component looks for the object — head aimed at it, arms and body out of the \
+         view, other views where one does not see it — and finds it (error against the scene \
+         file's pose, and the view it was found in), the grasp planner plans {planned_on}, the trajectory planner plans rest → grasp → \
          lift, the controller executes it. \"exact\" is the independent check's verdict \
          (force closure with the object's weight, recomputed from the reply's contacts); \
          \"executed\" is ok when the controller's published state at the end of `close` \

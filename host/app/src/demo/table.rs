@@ -1,11 +1,15 @@
 //! The demo's table: one row per scene, as printed and as written to the report.
 //!
 //! What: [`plan_cells`] (grasp type, region and face, whole-body joints, margin,
-//! the independent check's verdict), [`step_cells`] (vision error, motion
-//! planning time, motion duration, executed), [`header`] and [`row`] (the
-//! printed lines), and [`notes`] (the lines under a row saying what failed).
+//! the independent check's verdict), [`step_cells`] (vision error and the view
+//! it was found in, motion planning time, motion duration, executed),
+//! [`header`] and [`row`] (the printed lines), and [`notes`] (the lines under
+//! a row: the views of a look that took several, a plan on the scene file's
+//! pose for want of the vision's, what failed).
 //!
 //! Why: the terminal table and the Markdown report show the same cells.
+
+use tsukami_msgs::vision::LookView;
 
 use super::outcome::DemoScene;
 use super::step::{Step, StepStatus};
@@ -50,15 +54,16 @@ fn unfinished<T>(step: &Step<T>) -> Option<String> {
     }
 }
 
-/// One scene's step cells: vision pose error, motion planning time (ms),
-/// motion duration (s), executed.
+/// One scene's step cells: vision pose error and the view it was found in,
+/// motion planning time (ms), motion duration (s), executed.
 pub fn step_cells(s: &DemoScene) -> [String; 4] {
     let vision = match (&s.vision.data, s.vision.status) {
         (Some(v), StepStatus::Ok) => format!(
-            "{:.2}mm {:.2}°{}",
+            "{:.2}mm {:.2}°{} {}",
             v.position_error_mm,
             v.orientation_error_deg,
-            if v.within_tolerance { "" } else { " off" }
+            if v.within_tolerance { "" } else { " off" },
+            v.view
         ),
         _ if is_not_found(&s.vision) => "not found".to_owned(),
         _ => unfinished(&s.vision).unwrap_or_default(),
@@ -78,6 +83,18 @@ pub fn step_cells(s: &DemoScene) -> [String; 4] {
     [vision, motion_ms, motion_s, executed]
 }
 
+/// The views of a look, in words: `aim: not found (0.00); crouch: found (0.99)`.
+pub fn views(views: &[LookView]) -> String {
+    let view = |v: &LookView| {
+        let what = if v.found { "found" } else { "not found" };
+        match v.confidence {
+            Some(c) => format!("{}: {what} ({c:.2})", v.name),
+            None => format!("{}: {what}", v.name),
+        }
+    };
+    views.iter().map(view).collect::<Vec<_>>().join("; ")
+}
+
 /// Whether a failed vision step is the component's "not found" answer.
 fn is_not_found<T>(step: &Step<T>) -> bool {
     step.status == StepStatus::Failed
@@ -90,7 +107,7 @@ fn is_not_found<T>(step: &Step<T>) -> bool {
 /// The table's header line.
 pub fn header() -> String {
     format!(
-        "{:<11} {:<16} {:<5} {:<29} {:>6} {:>5}  {:<16} {:>7} {:>9} {:>8}  {:<8}  paper",
+        "{:<11} {:<16} {:<5} {:<29} {:>6} {:>5}  {:<24} {:>7} {:>9} {:>8}  {:<8}  paper",
         "scene",
         "grasp type",
         "face",
@@ -111,14 +128,22 @@ pub fn row(s: &DemoScene) -> String {
     let [vision, motion_ms, motion_s, executed] = step_cells(s);
     let verdict = if s.plan.ok { "ok" } else { "DIFFERS" };
     format!(
-        "{:<11} {grasp:<16} {face:<5} {joints:<29} {margin:>6} {exact:>5}  {vision:<16} {:>7.1} {motion_ms:>9} {motion_s:>8}  {executed:<8}  {verdict}: {}",
+        "{:<11} {grasp:<16} {face:<5} {joints:<29} {margin:>6} {exact:>5}  {vision:<24} {:>7.1} {motion_ms:>9} {motion_s:>8}  {executed:<8}  {verdict}: {}",
         s.plan.scene, s.plan.plan_ms, s.plan.expected
     )
 }
 
-/// The lines under a scene's row: the arm-only attempt, and what went wrong.
+/// The lines under a scene's row: the views of a look that took more than
+/// one, a plan on the scene file's pose for want of the vision's, the
+/// arm-only attempt, and what went wrong.
 pub fn notes(s: &DemoScene) -> Vec<String> {
     let mut out = Vec::new();
+    if let Some(v) = s.vision.data.as_ref().filter(|v| v.views.len() > 1) {
+        out.push(format!("look: {}", views(&v.views)));
+    }
+    if s.fell_back() {
+        out.push("planned on the scene file's pose: the vision did not find the object".into());
+    }
     if let Some(arm_only) = &s.plan.arm_only {
         out.push(format!("arm alone: {arm_only}"));
     }
@@ -142,6 +167,8 @@ pub fn notes(s: &DemoScene) -> Vec<String> {
 mod tests {
     use super::*;
     use crate::demo::outcome::PlanOn;
+    use crate::demo::vision::VisionCheck;
+    use tsukami_msgs::Pose;
 
     fn scene() -> DemoScene {
         DemoScene {
@@ -156,6 +183,7 @@ mod tests {
                 plan_ms: 1.0,
                 weight_scale: None,
             },
+            plan_on: PlanOn::Vision,
             planned_on: PlanOn::Scene,
             vision: Step::failed("infeasible: 'can_350ml' not found: no cluster", None),
             motion: Step::not_run("no grasp"),
@@ -175,10 +203,58 @@ mod tests {
         assert_eq!(
             notes(&s),
             [
+                "planned on the scene file's pose: the vision did not find the object",
                 "vision: bus error",
                 "execution: the grasp part ended `fault`"
             ]
         );
         assert!(row(&s).starts_with("can_breast "));
+        s.plan_on = PlanOn::Scene;
+        assert_eq!(
+            notes(&s).len(),
+            2,
+            "asked for the scene file's pose: no fallback"
+        );
+    }
+
+    fn view(name: &str, confidence: Option<f64>, found: bool) -> LookView {
+        LookView {
+            name: name.into(),
+            joints: Default::default(),
+            camera_pose: Pose {
+                position: [0.0; 3],
+                quaternion: [0.0, 0.0, 0.0, 1.0],
+            },
+            self_hidden: 0.0,
+            found,
+            confidence,
+            occluded: None,
+            reason: None,
+        }
+    }
+
+    #[test]
+    fn a_look_of_several_views_is_noted_and_the_view_named() {
+        let mut s = scene();
+        let pose = Pose {
+            position: [0.5, 0.0, 1.0],
+            quaternion: [0.0, 0.0, 0.0, 1.0],
+        };
+        s.planned_on = PlanOn::Vision;
+        s.vision = Step::ok(VisionCheck {
+            object: "pet_500ml".into(),
+            position_error_mm: 0.41,
+            orientation_error_deg: 0.2,
+            within_tolerance: true,
+            confidence: 0.99,
+            fit_error_mm: 0.7,
+            detect_ms: 800.0,
+            pose,
+            plan_pose: pose,
+            view: "crouch".into(),
+            views: vec![view("aim", None, false), view("crouch", Some(0.99), true)],
+        });
+        assert_eq!(step_cells(&s)[0], "0.41mm 0.20° crouch");
+        assert_eq!(notes(&s), ["look: aim: not found; crouch: found (0.99)"]);
     }
 }

@@ -1,12 +1,15 @@
-//! The demo's vision step: the vision component finds the scene's object in a
-//! frame of its simulated head camera, and the pose it reports is compared with
+//! The demo's vision step: the vision component looks for the scene's object
+//! with its simulated head camera, and the pose it reports is compared with
 //! the scene file's.
 //!
-//! What: [`detect`] asks `<ns>/vision/detect` and returns a [`VisionCheck`];
-//! [`pose_error`] is the symmetry-aware distance between two poses.
+//! What: [`detect`] asks `<ns>/vision/look` and returns a [`VisionCheck`]
+//! (with the views the look took); [`pose_error`] is the symmetry-aware
+//! distance between two poses; [`nearest_member`] the pose planned on.
 //!
-//! Why: the paper's robot measures the object with its head cameras before it
-//! plans; the demo shows how far that measurement is from the truth.
+//! Why: the paper's robot looks before it reaches — head turned to the
+//! object, arm out of the way, another view where one does not see it — and
+//! measures the object with its head cameras before it plans; the demo shows
+//! how far that measurement is from the truth, and plans on it.
 //!
 //! How: the error is taken modulo the object's symmetry as the component reports
 //! it: with a continuous axis (a can), where the axis point goes and where the
@@ -31,11 +34,11 @@
 
 use std::time::{Duration, Instant};
 
-use nalgebra::{Isometry3, Point3, Vector3};
+use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
 use serde::Serialize;
-use tsukami_msgs::vision::{DetectRequest, ObjectPose};
+use tsukami_msgs::vision::{LookReply, LookRequest, LookView, ObjectPose};
 use tsukami_msgs::Pose;
-use tsukami_scenes::geometry::pose_to_isometry;
+use tsukami_scenes::geometry::{isometry_to_pose, pose_to_isometry};
 
 use crate::client::BusClient;
 
@@ -59,14 +62,24 @@ pub struct VisionCheck {
     pub confidence: f64,
     /// RMS fit error, millimetres.
     pub fit_error_mm: f64,
-    /// Round trip of the detect request (render and detect), milliseconds.
+    /// Round trip of the look request (every view rendered and detected in),
+    /// milliseconds.
     pub detect_ms: f64,
     /// The reported pose.
     pub pose: Pose,
+    /// The pose a grasp is planned on (`--plan-on vision`): `pose` turned within
+    /// the object's symmetry to the member nearest the scene file's
+    /// ([`nearest_member`]).
+    pub plan_pose: Pose,
+    /// The name of the view the object was found in.
+    pub view: String,
+    /// The views the look took, in order (the component's `views`).
+    pub views: Vec<LookView>,
 }
 
-/// Asks the vision component for `object` in a simulated frame (noise seeded by
-/// `seed`) and compares the answer with `truth`.
+/// Asks the vision component to look for `object` with its simulated head
+/// camera (noise seeded by `seed`), where its scene has it, and compares the
+/// answer with `truth`.
 pub fn detect(
     client: &BusClient,
     object: &str,
@@ -74,9 +87,10 @@ pub fn detect(
     seed: u64,
     timeout: Duration,
 ) -> Result<VisionCheck, String> {
-    let request = DetectRequest {
+    let request = LookRequest {
         object: object.to_owned(),
-        image: None,
+        expected: None,
+        max_views: None,
         set_object: false,
         min_confidence: None,
         seed: Some(seed),
@@ -84,11 +98,17 @@ pub fn detect(
     let payload = serde_json::to_vec(&request).map_err(|e| e.to_string())?;
     let start = Instant::now();
     let reply = client
-        .request_key(&client.keys().vision_detect(), &payload, timeout)
+        .request_key(&client.keys().vision_look(), &payload, timeout)
         .map_err(|e| e.to_string())?;
     let detect_ms = start.elapsed().as_secs_f64() * 1e3;
-    let found: ObjectPose =
-        serde_json::from_slice(&reply).map_err(|e| format!("vision reply: {e}"))?;
+    let LookReply {
+        pose: found,
+        view,
+        views,
+    } = serde_json::from_slice(&reply).map_err(|e| format!("vision reply: {e}"))?;
+    let view = views
+        .get(view as usize)
+        .map_or_else(|| format!("#{view}"), |v| v.name.clone());
     let (dist, angle) = pose_error(&found, truth)?;
     let angle_deg = angle.to_degrees();
     Ok(VisionCheck {
@@ -100,27 +120,57 @@ pub fn detect(
         fit_error_mm: found.fit_error * 1e3,
         detect_ms,
         pose: found.pose,
+        plan_pose: nearest_member(&found, truth)?,
+        view,
+        views,
     })
+}
+
+/// The reported pose, its symmetry motions (the identity first) and its
+/// continuous axis (a point and a unit direction, object frame), parsed.
+struct Members {
+    estimate: Isometry3<f64>,
+    motions: Vec<Isometry3<f64>>,
+    axis: Option<(Point3<f64>, Vector3<f64>)>,
+}
+
+impl Members {
+    fn of(found: &ObjectPose) -> Result<Self, String> {
+        let estimate = pose_to_isometry(&found.pose).map_err(|e| format!("vision pose: {e}"))?;
+        let mut motions = vec![Isometry3::identity()];
+        let axis = found.symmetry.as_ref().and_then(|s| s.axis);
+        if let Some(symmetry) = &found.symmetry {
+            for pose in &symmetry.discrete {
+                motions.push(pose_to_isometry(pose).map_err(|e| format!("symmetry: {e}"))?);
+            }
+        }
+        let axis = axis.map(|a| {
+            (
+                Point3::from(a.point),
+                Vector3::from(a.direction).normalize(),
+            )
+        });
+        Ok(Members {
+            estimate,
+            motions,
+            axis,
+        })
+    }
 }
 
 /// Position (m) and orientation (rad) error of `found` against `truth`, modulo
 /// the symmetry `found` reports.
 pub fn pose_error(found: &ObjectPose, truth: &Pose) -> Result<(f64, f64), String> {
-    let estimate = pose_to_isometry(&found.pose).map_err(|e| format!("vision pose: {e}"))?;
+    let Members {
+        estimate,
+        motions,
+        axis,
+    } = Members::of(found)?;
     let truth = pose_to_isometry(truth).map_err(|e| format!("scene pose: {e}"))?;
-    let mut motions = vec![Isometry3::identity()];
-    let axis = found.symmetry.as_ref().and_then(|s| s.axis);
-    if let Some(symmetry) = &found.symmetry {
-        for pose in &symmetry.discrete {
-            motions.push(pose_to_isometry(pose).map_err(|e| format!("symmetry: {e}"))?);
-        }
-    }
     let error = |motion: &Isometry3<f64>| {
         let t = truth * motion;
         match axis {
-            Some(axis) => {
-                let point = Point3::from(axis.point);
-                let direction = Vector3::from(axis.direction).normalize();
+            Some((point, direction)) => {
                 let dist = (estimate * point - t * point).norm();
                 (dist, (estimate * direction).angle(&(t * direction)))
             }
@@ -135,6 +185,44 @@ pub fn pose_error(found: &ObjectPose, truth: &Pose) -> Result<(f64, f64), String
         .map(error)
         .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.total_cmp(&b.0)))
         .unwrap_or((f64::INFINITY, f64::INFINITY)))
+}
+
+/// The member of `found`'s symmetry set nearest `reference`: the reported
+/// pose composed with the discrete symmetry and the turn about the continuous
+/// axis that bring its frame closest to `reference`'s. What the vision
+/// measured (where the axis is and where it points, which shape it saw) is
+/// unchanged; only what no image can tell — the turn of a can about its axis
+/// — is taken from `reference`, so that a faceted mesh's facets lie where the
+/// reference's do.
+pub fn nearest_member(found: &ObjectPose, reference: &Pose) -> Result<Pose, String> {
+    let Members {
+        estimate,
+        motions,
+        axis,
+    } = Members::of(found)?;
+    let reference = pose_to_isometry(reference).map_err(|e| format!("scene pose: {e}"))?;
+    let member = |motion: &Isometry3<f64>| {
+        let pose = estimate * motion;
+        let Some((point, direction)) = axis else {
+            return pose;
+        };
+        let q = (pose.rotation.inverse() * reference.rotation).into_inner();
+        let along = q.imag().dot(&direction);
+        let turn = UnitQuaternion::from_axis_angle(
+            &nalgebra::Unit::new_unchecked(direction),
+            2.0 * along.atan2(q.w),
+        );
+        pose * Isometry3::rotation_wrt_point(turn, point)
+    };
+    let best = motions
+        .iter()
+        .map(member)
+        .min_by(|a, b| {
+            let angle = |p: &Isometry3<f64>| p.rotation.angle_to(&reference.rotation);
+            angle(a).total_cmp(&angle(b))
+        })
+        .unwrap_or(estimate);
+    Ok(isometry_to_pose(&best))
 }
 
 #[cfg(test)]
@@ -189,6 +277,45 @@ mod tests {
         let (d, a) = pose_error(&seen(tilted, Some(axis)), &truth).unwrap();
         assert!((a - 0.1).abs() < 1e-9, "{a}");
         assert!((d - 2.0 * 0.06 * (0.05f64).sin()).abs() < 1e-9, "{d}");
+    }
+
+    #[test]
+    fn the_member_planned_on_keeps_what_was_seen_and_takes_the_spin_from_the_scene() {
+        let axis = Symmetry {
+            axis: Some(SymmetryAxis {
+                point: [0.0, 0.0, 0.06],
+                direction: [0.0, 0.0, 1.0],
+            }),
+            discrete: vec![about_z(std::f64::consts::PI, [0.0; 3])],
+            note: String::new(),
+        };
+        let truth = about_z(0.3, [0.5, 0.0, 1.0]);
+        // Seen 2 mm to the side, tilted 0.02 rad about x, spun 2.5 rad.
+        let (s, c) = (0.01f64).sin_cos();
+        let tilt = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(c, s, 0.0, 0.0));
+        let spin = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 2.5);
+        let q = (tilt * spin).into_inner();
+        let seen_pose = Pose {
+            position: [0.5, 0.002, 1.0],
+            quaternion: [q.i, q.j, q.k, q.w],
+        };
+        let found = seen(seen_pose, Some(axis));
+        let member = nearest_member(&found, &truth).unwrap();
+        // Only the tilt is left against the truth, and the error is unchanged.
+        let (m, t) = (
+            pose_to_isometry(&member).unwrap(),
+            pose_to_isometry(&truth).unwrap(),
+        );
+        assert!((m.rotation.angle_to(&t.rotation) - 0.02).abs() < 1e-9);
+        let (d0, a0) = pose_error(&found, &truth).unwrap();
+        let (d1, a1) = pose_error(&seen(member, found.symmetry.clone()), &truth).unwrap();
+        assert!(
+            (d0 - d1).abs() < 1e-12 && (a0 - a1).abs() < 1e-12,
+            "{d0} {d1} {a0} {a1}"
+        );
+        // Without a symmetry, the pose is what was seen.
+        let plain = nearest_member(&seen(seen_pose, None), &truth).unwrap();
+        assert_eq!(plain.position, seen_pose.position);
     }
 
     #[test]
