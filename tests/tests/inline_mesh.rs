@@ -177,22 +177,7 @@ fn an_inline_mesh_from_another_process_plans_on_every_plugin() {
     let refused = world(&c, "set_object", object.to_string().as_bytes()).unwrap_err();
     assert_eq!(refused.code().map(|c| c.as_str()), Some("model_error"));
     object["shape"]["mesh"]["scale"] = 1.0.into();
-    let out = Command::new(tsukami_exe())
-        .args(["set-object", "--inline", &object.to_string()])
-        .args([
-            "--connect",
-            &config.bus.listen[0],
-            "--namespace",
-            &config.namespace,
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let r = set_object_inline_cli(&config, &object);
     assert_eq!(r["name"], "my_can", "{r}");
     let again = plan(&c);
     assert_eq!(again["world_version"], r["world_version"]);
@@ -220,22 +205,7 @@ fn an_inline_ply_plans_the_grasp_of_its_model_from_json_and_from_the_cli() {
     std::fs::write(&copy, can_ply()).unwrap();
     let (_, mut object, _) = scene_with(json!({"mesh": {"path": copy}}));
     object.as_object_mut().unwrap().remove("name");
-    let out = Command::new(tsukami_exe())
-        .args(["set-object", "--inline", &object.to_string()])
-        .args([
-            "--connect",
-            &config.bus.listen[0],
-            "--namespace",
-            &config.namespace,
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let r: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let r = set_object_inline_cli(&config, &object);
     assert_eq!(r["name"], "Scanned_Can", "{r}");
     let state = world(&c, "get", b"{}").unwrap();
     assert_eq!(state["object"]["shape"]["inline"]["format"], "ply");
@@ -417,4 +387,24 @@ fn too_large_bad_and_garbage_inline_meshes_are_refused_and_the_world_stays() {
     let again = plan(&c);
     assert_eq!(again["world_version"], baseline["world_version"]);
     assert_eq!(grasp_of(&again), grasp_of(&baseline), "the plan changed");
+}
+
+/// `tsukami set-object --inline OBJECT` against the test host: its reply.
+fn set_object_inline_cli(config: &HostConfig, object: &Value) -> Value {
+    let out = Command::new(tsukami_exe())
+        .args(["set-object", "--inline", &object.to_string()])
+        .args([
+            "--connect",
+            &config.bus.listen[0],
+            "--namespace",
+            &config.namespace,
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
 }
