@@ -48,6 +48,14 @@ use tsukami_msgs::planner::{BoxFace, FaceBlock, OcpBox, Pose};
 /// count as equally long when choosing the axis to split along.
 const LONGEST_TIE: f64 = 0.02;
 
+/// Spreads of two readings of a profile within this fraction of each other
+/// are equal ([`segment_profile`]).
+const SPREAD_TIE: f64 = 0.01;
+
+/// A split axis whose vertical (or x) component is below this counts as
+/// level for [`canonical_sign`] (sin 10°).
+const LEVEL: f64 = 0.17;
+
 /// Parameters of the OCP computation.
 #[derive(Debug, Clone)]
 pub struct OcpParams {
@@ -254,20 +262,9 @@ fn principal_axes(cov: &Matrix3<f64>, params: &OcpParams) -> Rotation3<f64> {
         None
     };
     if let Some((i, j, k)) = pair {
-        let normal = axes[k];
-        let candidates = [
-            params.preferred_axis,
-            Vector3::z(),
-            Vector3::x(),
-            Vector3::y(),
-        ];
-        for c in candidates {
-            let p = c - normal * normal.dot(&c);
-            if p.norm() > 0.3 * c.norm().max(1e-12) {
-                axes[i] = p.normalize();
-                axes[j] = normal.cross(&axes[i]);
-                break;
-            }
+        if let Some((a, b)) = preferred_pair(&axes[k], params) {
+            axes[i] = a;
+            axes[j] = b;
         }
     } else if same(vals[0], vals[2]) {
         // Fully symmetric (a sphere, a cube): use the world axes.
@@ -279,6 +276,52 @@ fn principal_axes(cov: &Matrix3<f64>, params: &OcpParams) -> Rotation3<f64> {
     // Right-handed: the third axis follows from the first two.
     axes[2] = axes[0].cross(&axes[1]).normalize();
     Rotation3::from_matrix_unchecked(Matrix3::from_columns(&axes))
+}
+
+/// Two axes across `normal` for a cross-section that does not choose its own
+/// (a circle's): the first follows the preferred direction (or, when that is
+/// along `normal`, the world's z, x or y).
+fn preferred_pair(normal: &Vector3<f64>, params: &OcpParams) -> Option<(Vector3<f64>, Vector3<f64>)> {
+    let candidates = [params.preferred_axis, Vector3::z(), Vector3::x(), Vector3::y()];
+    candidates.into_iter().find_map(|c| {
+        let p = c - normal * normal.dot(&c);
+        (p.norm() > 0.3 * c.norm().max(1e-12)).then(|| {
+            let a = p.normalize();
+            (a, normal.cross(&a))
+        })
+    })
+}
+
+/// The box axes of a slab of the object cut across `axis`: `axis` itself and
+/// the principal axes of the slab's surface across it, largest variance
+/// first; a symmetric cross-section takes [`preferred_pair`]. Every region of
+/// a split shares the split axis, so a region's box cannot tilt on its own
+/// when its three variances come close (a squat neck), which would change its
+/// sizes with the smallest move of the object.
+fn slab_axes(cov: &Matrix3<f64>, axis: &Vector3<f64>, params: &OcpParams) -> Rotation3<f64> {
+    let p = Matrix3::identity() - axis * axis.transpose();
+    let across = SymmetricEigen::new(p * cov * p);
+    // The eigenvector along `axis` has eigenvalue 0; the other two lie across it.
+    let mut inplane: Vec<(f64, Vector3<f64>)> = (0..3)
+        .map(|k| (across.eigenvalues[k], across.eigenvectors.column(k).into_owned()))
+        .collect();
+    inplane.sort_by(|a, b| a.1.dot(axis).abs().total_cmp(&b.1.dot(axis).abs()));
+    inplane.truncate(2);
+    inplane.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let (big, small) = (inplane[0].0, inplane[1].0);
+    let (u, v) = match preferred_pair(axis, params) {
+        Some(pair) if big - small <= params.symmetry_tolerance * big.abs().max(1e-300) => pair,
+        _ => {
+            let u = (inplane[0].1 - axis * axis.dot(&inplane[0].1)).normalize();
+            (u, axis.cross(&u))
+        }
+    };
+    // Largest variance first, right-handed.
+    let along = (axis.transpose() * cov * axis)[0];
+    let mut cols = [(along, *axis), (big, u), (small, v)];
+    cols.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let (a, b) = (cols[0].1, cols[1].1);
+    Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[a, b, a.cross(&b)]))
 }
 
 /// Box around a patch: PCA axes, extents from vertex projections.
@@ -446,8 +489,57 @@ fn hole_runs(flags: &[bool], min_len: usize) -> Vec<std::ops::Range<usize>> {
     out.into_iter().map(|(r, _)| r).collect()
 }
 
-/// Cuts the radius profile into runs of similar radius; returns slice index ranges.
+/// Cuts the radius profile into runs of similar radius; returns slice index
+/// ranges.
+///
+/// The profile is read from each end ([`greedy_runs`]): cut where neighbouring
+/// slices jump by more than [`OcpParams::jump_fraction`] of the largest radius
+/// or a run's radius range grows beyond [`OcpParams::range_fraction`] of its
+/// largest; then short runs and similar neighbours merge. The two readings can
+/// differ (from its foot a vase's neck and lip read as one uneven run, from
+/// its lip as two even ones): the one with fewer uneven runs is taken, then
+/// the one with fewer runs, then the one whose radii spread least about their
+/// runs' means. The result does not depend on which way the axis points.
 fn segment_profile(radii: &[f64], params: &OcpParams) -> Vec<std::ops::Range<usize>> {
+    let n = radii.len();
+    let forward = greedy_runs(radii, params);
+    let reversed: Vec<f64> = radii.iter().rev().copied().collect();
+    let mut backward: Vec<std::ops::Range<usize>> = greedy_runs(&reversed, params)
+        .into_iter()
+        .map(|r| (n - r.end)..(n - r.start))
+        .collect();
+    backward.reverse();
+    if forward == backward {
+        return forward;
+    }
+    let score = |runs: &[std::ops::Range<usize>]| {
+        let (mut uneven, mut spread) = (0usize, 0.0);
+        for r in runs {
+            let v = &radii[r.clone()];
+            let (lo, hi) = v
+                .iter()
+                .fold((f64::INFINITY, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+            uneven += usize::from(hi - lo > params.range_fraction * hi);
+            let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+            spread += v.iter().map(|x| (x - mean).powi(2)).sum::<f64>();
+        }
+        (uneven, runs.len(), spread)
+    };
+    // Of equal readings (a sphere's, mirror images) the one from the
+    // first slice: the axis's sign is fixed ([`canonical_sign`]).
+    let (f, b) = (score(&forward), score(&backward));
+    let less_spread = b.2 < (1.0 - SPREAD_TIE) * f.2;
+    if (b.0, b.1) < (f.0, f.1) || ((b.0, b.1) == (f.0, f.1) && less_spread) {
+        backward
+    } else {
+        forward
+    }
+}
+
+/// Cuts the radius profile into runs of similar radius, read from its first
+/// slice on: cut at jumps and where a run grows uneven, then short runs and
+/// similar neighbours merged (see [`segment_profile`]).
+fn greedy_runs(radii: &[f64], params: &OcpParams) -> Vec<std::ops::Range<usize>> {
     let n = radii.len();
     let rmax = radii.iter().cloned().fold(0.0, f64::max);
     if n == 0 || rmax <= 0.0 {
@@ -542,6 +634,25 @@ fn segment_profile(radii: &[f64], params: &OcpParams) -> Vec<std::ops::Range<usi
     runs
 }
 
+/// `axis` or its opposite, whichever points up (or, for an axis within
+/// [`LEVEL`] of horizontal, along +x, then +y). An eigenvector's sign is
+/// arbitrary and flips with the smallest change of the surface; the profile
+/// along it is read from one end.
+fn canonical_sign(axis: Vector3<f64>) -> Vector3<f64> {
+    let key = if axis.z.abs() > LEVEL {
+        axis.z
+    } else if axis.x.abs() > LEVEL {
+        axis.x
+    } else {
+        axis.y
+    };
+    if key < 0.0 {
+        -axis
+    } else {
+        axis
+    }
+}
+
 /// Where the object's box is cut into regions: along `axis`, between
 /// `t0` and `t1`, into runs of `n` slices.
 struct Split {
@@ -563,7 +674,7 @@ impl Split {
             .find(|&k| global.extents[k] >= (1.0 - LONGEST_TIE) * longest)
             .unwrap_or(0);
         let m = global.rotation.matrix();
-        let axis = m.column(long).into_owned();
+        let axis = canonical_sign(m.column(long).into_owned());
         let center = global.center.coords;
         let c = axis.dot(&center);
         let (t0, t1) = (
@@ -647,8 +758,10 @@ pub fn object_ocps(
                 })
                 .collect();
             let patch = Patch { polygons };
-            if let Some(b) = patch_box(&patch, params, out.len()) {
-                out.push(b);
+            let m = patch.moments();
+            if m.area > 0.0 {
+                let rotation = slab_axes(&m.covariance(), &split.axis, params);
+                out.push(box_from_axes(&patch, rotation, out.len()));
             }
         }
         out
