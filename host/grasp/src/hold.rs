@@ -30,11 +30,13 @@
 //! times the worst disturbance it resists). Disturbances are tried in the
 //! order given and the test stops at the first one below 1 (its index is
 //! reported), so a search spends one program on most rejected samples. A
-//! deciding test ([`HoldOptions::decide_only`], what searches use) first
+//! deciding test ([`HoldOptions::decide_up_to`], what searches use) first
 //! tries each disturbance with the cheap sufficient test of
 //! [`crate::superposition`] on the squeeze, and solves the program only when
 //! that fails: the same verdict, one program instead of thirteen for most
-//! grasps that hold.
+//! grasps that hold. Deciding up to a scale `c` gives the hold margin
+//! clipped at `c` the same way (what a planner ranking by a preferred margin
+//! needs).
 //!
 //! ```
 //! use nalgebra::{Matrix3xX, Point3, Vector3};
@@ -81,12 +83,13 @@ pub struct HoldOptions {
     pub friction_reserve: f64,
     /// Require exact force closure (default true).
     pub require_closure: bool,
-    /// Decide only (default false): a disturbance that the squeeze plus the
-    /// least-norm forces balance at [`DECIDE_SAFETY`] times
-    /// ([`crate::superposition`]) is passed without its program, and its
-    /// scale is reported as [`DECIDE_SAFETY`], a lower bound. The verdict
-    /// `holds()` is the same as the exact one's; the margins are not.
-    pub decide_only: bool,
+    /// Decide up to a scale (default `None`: every scale exact). With
+    /// `Some(c)`, a disturbance that the squeeze plus the least-norm forces
+    /// balance at `c` times ([`crate::superposition`]) is passed without its
+    /// program and its scale is reported as `c`, a lower bound: the margin is
+    /// the exact one clipped at `c`, and for `c ≥ 1` the verdict `holds()` is
+    /// the exact one's. Searches decide at [`DECIDE_SAFETY`].
+    pub decide_up_to: Option<f64>,
 }
 
 /// The multiple of a disturbance the cheap test of a deciding hold test
@@ -99,7 +102,7 @@ impl Default for HoldOptions {
         Self {
             friction_reserve: 0.2,
             require_closure: true,
-            decide_only: false,
+            decide_up_to: None,
         }
     }
 }
@@ -216,8 +219,8 @@ pub fn hold_test(
     }
     out.margin = f64::INFINITY;
     for (i, d) in set.0.iter().enumerate() {
-        let s = match &fast {
-            Some(f) if f.resists(&d.wrench, DECIDE_SAFETY) => DECIDE_SAFETY,
+        let s = match (&fast, opts.decide_up_to) {
+            (Some(f), Some(c)) if f.resists(&d.wrench, c) => c,
             _ => {
                 exact_weight_scale_with(g, ConeModel::Circular, &d.wrench, Some(joints))?
                     .weight_scale
@@ -248,7 +251,7 @@ fn closure(
     opts: &HoldOptions,
 ) -> Result<(bool, Option<Superposition>), ExactError> {
     let exact = |g: &Grasp| exact_force_closure_with(g, ConeModel::Circular, None);
-    if !opts.decide_only {
+    if opts.decide_up_to.is_none() {
         let fc = !opts.require_closure || exact(grasp)?.force_closure;
         return Ok((fc, None));
     }

@@ -135,6 +135,18 @@ impl<'a> Run<'a> {
         crate::verify::hold_margin(world, grasp, req)
     }
 
+    /// [`Run::hold_margin`] clipped at `cap` ([`crate::verify::hold_margin_up_to`]):
+    /// enough to compare with a preferred margin, for fewer programs.
+    pub fn hold_margin_up_to<P: GraspPlanner>(
+        &self,
+        world: &World<'_, P>,
+        grasp: &Grasp,
+        req: &HoldRequest,
+        cap: f64,
+    ) -> Option<f64> {
+        crate::verify::hold_margin_up_to(world, grasp, req, cap)
+    }
+
     /// How many of the request's object pose errors `grasp` still holds
     /// under ([`crate::verify::robustness`], the kit's re-check). The last
     /// answer is kept, so the verification of the grasp a planner chose on it

@@ -37,8 +37,8 @@ use tsukami_body::model::LinkId;
 
 use crate::blocks::grasp_check::check_in;
 use crate::blocks::hold::{
-    compliance, holds_exactly, holds_under, passive_response, squeeze, HoldContact, HoldProblem,
-    PassiveResponse,
+    compliance, holds_exactly, holds_under, holds_up_to, passive_response, squeeze, HoldContact,
+    HoldProblem, PassiveResponse,
 };
 use crate::blocks::robust::{pose_robustness, RobustProblem};
 use crate::blocks::wrap::{style_check, StyleRule};
@@ -283,13 +283,39 @@ pub fn hold_margin<P: GraspPlanner>(
     grasp: &Grasp,
     req: &HoldRequest,
 ) -> Option<f64> {
+    hold_margin_with(world, grasp, req, None)
+}
+
+/// [`hold_margin`] clipped at `cap` (`blocks::hold::holds_up_to`): the same
+/// `None`, and `min(hold_margin, cap)` within the solver's rounding, for a
+/// fraction of the programs. Planners that only compare the margin with a
+/// preferred one call this.
+pub fn hold_margin_up_to<P: GraspPlanner>(
+    world: &World<'_, P>,
+    grasp: &Grasp,
+    req: &HoldRequest,
+    cap: f64,
+) -> Option<f64> {
+    hold_margin_with(world, grasp, req, Some(cap))
+}
+
+fn hold_margin_with<P: GraspPlanner>(
+    world: &World<'_, P>,
+    grasp: &Grasp,
+    req: &HoldRequest,
+    cap: Option<f64>,
+) -> Option<f64> {
     let model = &world.robot.model;
     let mut fk = FkState::new(model);
     model.forward_kinematics(&grasp.q, &mut fk);
     let problem = hold_problem(world, &fk, grasp_length(world, grasp));
-    holds_exactly(&problem, &hold_contacts(&grasp.contacts), req)
-        .ok()
-        .map(|v| v.margin)
+    let contacts = hold_contacts(&grasp.contacts);
+    match cap {
+        Some(c) => holds_up_to(&problem, &contacts, req, c),
+        None => holds_exactly(&problem, &contacts, req),
+    }
+    .ok()
+    .map(|v| v.margin)
 }
 
 /// The characteristic length of `grasp`: its own when valid, else the object's.

@@ -708,7 +708,7 @@ fn check_hold(
     let physics = HoldOptions {
         friction_reserve: 0.0,
         require_closure: true,
-        decide_only: false,
+        decide_up_to: None,
     };
     match hold_test(&grasp, &torques, &set, &physics) {
         Ok(v) if !v.force_closure => out.push(Violation::NotForceClosure),

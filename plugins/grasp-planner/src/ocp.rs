@@ -281,8 +281,16 @@ fn principal_axes(cov: &Matrix3<f64>, params: &OcpParams) -> Rotation3<f64> {
 /// Two axes across `normal` for a cross-section that does not choose its own
 /// (a circle's): the first follows the preferred direction (or, when that is
 /// along `normal`, the world's z, x or y).
-fn preferred_pair(normal: &Vector3<f64>, params: &OcpParams) -> Option<(Vector3<f64>, Vector3<f64>)> {
-    let candidates = [params.preferred_axis, Vector3::z(), Vector3::x(), Vector3::y()];
+fn preferred_pair(
+    normal: &Vector3<f64>,
+    params: &OcpParams,
+) -> Option<(Vector3<f64>, Vector3<f64>)> {
+    let candidates = [
+        params.preferred_axis,
+        Vector3::z(),
+        Vector3::x(),
+        Vector3::y(),
+    ];
     candidates.into_iter().find_map(|c| {
         let p = c - normal * normal.dot(&c);
         (p.norm() > 0.3 * c.norm().max(1e-12)).then(|| {
@@ -303,7 +311,12 @@ fn slab_axes(cov: &Matrix3<f64>, axis: &Vector3<f64>, params: &OcpParams) -> Rot
     let across = SymmetricEigen::new(p * cov * p);
     // The eigenvector along `axis` has eigenvalue 0; the other two lie across it.
     let mut inplane: Vec<(f64, Vector3<f64>)> = (0..3)
-        .map(|k| (across.eigenvalues[k], across.eigenvectors.column(k).into_owned()))
+        .map(|k| {
+            (
+                across.eigenvalues[k],
+                across.eigenvectors.column(k).into_owned(),
+            )
+        })
         .collect();
     inplane.sort_by(|a, b| a.1.dot(axis).abs().total_cmp(&b.1.dot(axis).abs()));
     inplane.truncate(2);

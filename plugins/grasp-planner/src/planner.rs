@@ -48,7 +48,10 @@ use crate::link_sets::LinkSets;
 use crate::object::PlanObject;
 use crate::ocp::{Ocp, OcpParams};
 use crate::palm_pose::{criterion_value, palm_targets};
-use crate::search::{search, Counters, Found, Judged, Outcome, SearchContext, SearchParams};
+use crate::search::{
+    search, Bar, Counters, Found, Judged, Outcome, SearchContext, SearchParams,
+    ROBUST_EXTRA_SAMPLES,
+};
 use crate::selection::{select, Candidate, Selection};
 use crate::tilt::tilts;
 use crate::whole_body::{stages, StageJoints};
@@ -348,20 +351,31 @@ impl Paper {
                     .wrapping_mul(0x9E37_79B9_7F4A_7C15)
                     .wrapping_add(((tier as u64) << 32) | ((si as u64) << 16) | k as u64);
                 let ti = nom.candidate.grasp_type;
+                // Once a grasp is set aside, a later nominal pose only gets
+                // the samples the first got after its partial grasp.
+                let limit = match partial {
+                    Some(_) => ROBUST_EXTRA_SAMPLES,
+                    None => u32::MAX,
+                };
                 let outcome = search(
                     ctx,
                     ti,
                     &stage,
-                    &nom.palm,
-                    &nom.q,
+                    (&nom.palm, &nom.q),
                     seed,
+                    limit,
                     &mut t.counters,
-                    &mut |found| {
+                    &mut |found, bar| {
                         let g = grasp(g.to_ref(), &nom.candidate, &stage, found.clone(), object);
                         run.motion_phases(w, &g).map_err(|b| b.to_string())?;
+                        // Only compared with the preferred margin.
+                        let hold_margin =
+                            run.hold_margin_up_to(w, &g, &opts.hold, pm).unwrap_or(0.0);
+                        let robustness = Bar::may_beat(bar, found.off_edges(), hold_margin.min(pm))
+                            .then(|| run.pose_robustness(w, &g, &opts.hold, opts.seed));
                         Ok(Judged {
-                            robustness: run.pose_robustness(w, &g, &opts.hold, opts.seed),
-                            hold_margin: run.hold_margin(w, &g, &opts.hold).unwrap_or(0.0),
+                            robustness,
+                            hold_margin,
                         })
                     },
                 );

@@ -28,7 +28,12 @@
 //! must it reach δf as well. The
 //! generator is ChaCha8 seeded by the caller: the same seed, same result. The
 //! cancel flag and the deadline are checked before every sample (a sample
-//! takes well under a millisecond).
+//! takes well under a millisecond). Two rules stop a search before its
+//! budget, both counted in samples: a nominal pose none of whose first
+//! [`STALL_SAMPLES`] open hands was clear of the object and the obstacles is
+//! given up, and a
+//! caller that already holds a grasp that is not preferred passes a `limit`
+//! of [`ROBUST_EXTRA_SAMPLES`].
 
 use std::cell::Cell;
 use std::collections::BTreeMap;
@@ -89,7 +94,21 @@ pub struct SearchParams {
     /// What an accepted sample must resist (the kit's hold test,
     /// `tsukami_planner_kit::blocks::hold`, the same the verification applies).
     pub hold: HoldRequest,
+    /// A nominal pose is given up after this many samples when the open hand
+    /// of none of them was clear (every one failed the IK or collided before
+    /// closing): [`STALL_SAMPLES`] by default.
+    pub stall_samples: u32,
 }
+
+/// Samples after which a nominal pose none of whose open hands was clear is
+/// given up ([`SearchParams::stall_samples`]). Draws around one nominal pose
+/// share its neighbourhood: when a hundred open hands there all collide (or
+/// have no IK solution), the free share of that neighbourhood is below 3 % at
+/// 95 % confidence (the rule of three), and the other nominal poses are the
+/// better use of the budget. (Counting only samples that reach the force
+/// tests gave up too early: on low objects the Allegro's fingers close on
+/// one sample in two or three hundred.)
+pub const STALL_SAMPLES: u32 = 100;
 
 impl Default for SearchParams {
     fn default() -> Self {
@@ -103,6 +122,7 @@ impl Default for SearchParams {
             contact_distance: 0.002,
             paper_rule: false,
             hold: HoldRequest::default(),
+            stall_samples: STALL_SAMPLES,
         }
     }
 }
@@ -176,10 +196,37 @@ impl Found {
 /// What the kit says of an accepted grasp ([`Judge`]).
 #[derive(Debug, Clone, Copy)]
 pub struct Judged {
-    /// Of the request's object pose errors, how many it still holds under.
-    pub robustness: PoseRobustness,
-    /// Its exact hold margin.
+    /// Of the request's object pose errors, how many it still holds under;
+    /// `None` when the judge skipped the re-check because the grasp cannot
+    /// beat the kept one ([`Bar::may_beat`]).
+    pub robustness: Option<PoseRobustness>,
+    /// Its exact hold margin (clipped at the preferred one is enough).
     pub hold_margin: f64,
+}
+
+/// The grasp a search keeps while it looks for a preferred one, as a later
+/// accepted sample must beat it ([`Found::rank`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Bar {
+    /// Its rank.
+    pub rank: (u32, bool, f64),
+    /// Whether it held under every pose error.
+    pub robust: bool,
+}
+
+impl Bar {
+    /// Whether a sample whose contacts are `off_edges` and whose hold margin
+    /// clipped at the preferred one is `margin` can be preferred or beat the
+    /// kept grasp, whatever its robustness. When the kept grasp held under
+    /// every error, no sample with an equal or lower `(off_edges, margin)`
+    /// can (nor be preferred: the kept one would have been), so the judge
+    /// may skip the pose-error re-check, the costliest test.
+    pub fn may_beat(bar: Option<Self>, off_edges: bool, margin: f64) -> bool {
+        match bar {
+            Some(b) if b.robust => (off_edges, margin) > (b.rank.1, b.rank.2),
+            _ => true,
+        }
+    }
 }
 
 /// How a search ended.
@@ -268,7 +315,7 @@ impl Counters {
 /// checks), else how many of the request's object pose errors it still holds
 /// under (`Run::pose_robustness`) and its exact hold margin
 /// (`Run::hold_margin`).
-pub type Judge<'h> = dyn FnMut(&Found) -> Result<Judged, String> + 'h;
+pub type Judge<'h> = dyn FnMut(&Found, Option<Bar>) -> Result<Judged, String> + 'h;
 
 /// Algorithm 1 around one nominal pose. `q_nominal` is the nominal IK solution
 /// (full vector) for grasp type `t` over `stage`. An accepted grasp whose
@@ -278,20 +325,21 @@ pub type Judge<'h> = dyn FnMut(&Found) -> Result<Judged, String> + 'h;
 /// is kept while the search goes on for at most [`ROBUST_EXTRA_SAMPLES`]
 /// samples, and the best kept ([`Found::rank`], the first of equals) is
 /// returned then as [`Outcome::Partial`]: the caller tries its other nominal
-/// poses before it takes it.
+/// poses before it takes it, each with `limit` samples at most
+/// ([`ROBUST_EXTRA_SAMPLES`] once it holds a partial grasp).
 #[allow(clippy::too_many_arguments)]
 pub fn search(
     ctx: &SearchContext<'_>,
     t: usize,
     stage: &StageJoints,
-    nominal_palm: &Isometry3<f64>,
-    q_nominal: &[f64],
+    (nominal_palm, q_nominal): (&Isometry3<f64>, &[f64]),
     seed: u64,
+    limit: u32,
     counters: &mut Counters,
     judge: &mut Judge<'_>,
 ) -> Outcome {
     let mut best: Option<Box<Found>> = None;
-    let stop_at = Cell::new(u32::MAX);
+    let stop_at = Cell::new(limit);
     let outcome = sample_loop(
         ctx,
         (t, stage),
@@ -299,19 +347,28 @@ pub fn search(
         seed,
         counters,
         &mut |found, at, counters| {
-            let j = match judge(&found) {
+            let preferred = ctx.params.hold.preferred_margin;
+            let bar = best.as_ref().map(|b| Bar {
+                rank: b.rank(preferred),
+                robust: b.robustness.held == b.robustness.samples,
+            });
+            let j = match judge(&found, bar) {
                 Ok(j) => j,
                 Err(why) => {
                     counters.reject(9, Some(why));
                     return None;
                 }
             };
+            let Some(robustness) = j.robustness else {
+                // It cannot beat the kept grasp (`Bar::may_beat`).
+                counters.reject(if found.off_edges() { 10 } else { 11 }, None);
+                return None;
+            };
             let found = Box::new(Found {
-                robustness: j.robustness,
+                robustness,
                 hold_margin: j.hold_margin,
                 ..found
             });
-            let preferred = ctx.params.hold.preferred_margin;
             if found.preferred(preferred) {
                 return Some(Outcome::Found(found));
             }
@@ -325,7 +382,7 @@ pub fn search(
             };
             counters.reject(reason, None);
             if best.is_none() {
-                stop_at.set(at.saturating_add(ROBUST_EXTRA_SAMPLES));
+                stop_at.set(stop_at.get().min(at.saturating_add(ROBUST_EXTRA_SAMPLES)));
             }
             if best
                 .as_ref()
@@ -369,8 +426,9 @@ fn sample_loop(
     let mut fk = FkState::new(&hand.robot);
     let mut q = q_nominal.to_vec();
     let mut exact_ms = 0.0;
+    let mut first_clear: Option<u32> = None;
     for s in 0..p.max_samples {
-        if s >= stop_at.get() {
+        if s >= stop_at.get() || (first_clear.is_none() && s >= p.stall_samples) {
             break;
         }
         if ctx.cancel.load(Ordering::Relaxed) {
@@ -389,6 +447,7 @@ fn sample_loop(
             counters.reject(1, Some(why));
             continue;
         }
+        first_clear.get_or_insert(s);
         let Some(mut contacts) = close_fingers(
             hand,
             t,

@@ -26,8 +26,7 @@ struct Region {
 fn regions(mesh: &TriangleMesh, pose: &Isometry3<f64>) -> Vec<Region> {
     let v: Vec<Point3<f64>> = mesh.vertices.iter().map(|p| pose * p).collect();
     let ocps: Vec<Ocp> = object_ocps(&v, &mesh.indices, &OcpParams::default());
-    ocps
-        .iter()
+    ocps.iter()
         .map(|o| {
             let mut sizes = [o.extents.x, o.extents.y, o.extents.z];
             sizes.sort_by(f64::total_cmp);
@@ -85,11 +84,25 @@ type Move = (String, Isometry3<f64>, f64, f64);
 /// box refitted to the turned surface.
 fn moves(centre: Vector3<f64>, size: f64) -> Vec<Vec<Move>> {
     let mut out = Vec::new();
-    for (name, dir) in [("x", Vector3::x()), ("y", Vector3::y()), ("z", Vector3::z())] {
-        let mut run: Vec<Move> = vec![(format!("{name} +0.1 µm"), Translation3::from(dir * 1e-7).into(), 1e-4, 1e-4)];
+    for (name, dir) in [
+        ("x", Vector3::x()),
+        ("y", Vector3::y()),
+        ("z", Vector3::z()),
+    ] {
+        let mut run: Vec<Move> = vec![(
+            format!("{name} +0.1 µm"),
+            Translation3::from(dir * 1e-7).into(),
+            1e-4,
+            1e-4,
+        )];
         for k in 1..=10 {
             let d = 1e-4 * k as f64;
-            run.push((format!("{name} +{:.1} mm", d * 1e3), Translation3::from(dir * d).into(), 1e-4, 1e-4));
+            run.push((
+                format!("{name} +{:.1} mm", d * 1e3),
+                Translation3::from(dir * d).into(),
+                1e-4,
+                1e-4,
+            ));
         }
         out.push(run);
     }
@@ -98,13 +111,22 @@ fn moves(centre: Vector3<f64>, size: f64) -> Vec<Vec<Move>> {
         // About the object's centre.
         Translation3::from(centre) * r * Translation3::from(-centre)
     };
-    for (name, axis) in [("x", Vector3::x()), ("y", Vector3::y()), ("z", Vector3::z())] {
+    for (name, axis) in [
+        ("x", Vector3::x()),
+        ("y", Vector3::y()),
+        ("z", Vector3::z()),
+    ] {
         let run = (1..=10)
             .map(|k| {
                 let deg = 0.01 * k as f64;
                 let tol = EDGE_TURN + TILT_SLOPE * size * deg.to_radians();
                 let step = EDGE_TURN + TILT_SLOPE * size * 0.01f64.to_radians();
-                (format!("turn about {name} {deg:.2}°"), about(axis, deg), tol, step)
+                (
+                    format!("turn about {name} {deg:.2}°"),
+                    about(axis, deg),
+                    tol,
+                    step,
+                )
             })
             .collect();
         out.push(run);
@@ -114,7 +136,10 @@ fn moves(centre: Vector3<f64>, size: f64) -> Vec<Vec<Move>> {
 
 /// Checks one object in one pose; returns the failures.
 fn check(name: &str, mesh: &TriangleMesh, base: Isometry3<f64>) -> Vec<String> {
-    let (mut lo, mut hi) = (Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY));
+    let (mut lo, mut hi) = (
+        Vector3::repeat(f64::INFINITY),
+        Vector3::repeat(f64::NEG_INFINITY),
+    );
     for p in &mesh.vertices {
         let w = (base * p).coords;
         lo = lo.inf(&w);
@@ -127,7 +152,10 @@ fn check(name: &str, mesh: &TriangleMesh, base: Isometry3<f64>) -> Vec<String> {
         let mut previous = reference.clone();
         for (what, m, tol, step) in run {
             let now = regions(mesh, &(m * base));
-            let against = [("the unmoved object", &reference, tol), ("the step before", &previous, step)];
+            let against = [
+                ("the unmoved object", &reference, tol),
+                ("the step before", &previous, step),
+            ];
             for (whom, was, allowed) in against {
                 match difference(was, &now) {
                     Ok(d) if d <= allowed => {}
@@ -164,7 +192,11 @@ fn regions_move_continuously_with_the_object() {
     let mut failures = Vec::new();
     let mut checked = 0;
     for (name, mesh) in &cases {
-        let poses = [("standing", standing), ("lying", lying), ("lying turned 30°", turned)];
+        let poses = [
+            ("standing", standing),
+            ("lying", lying),
+            ("lying turned 30°", turned),
+        ];
         for (pose_name, pose) in poses {
             failures.extend(check(&format!("{name} {pose_name}"), mesh, pose));
             checked += 1;

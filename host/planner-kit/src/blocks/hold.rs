@@ -29,7 +29,7 @@ use tsukami_body::kinematics::FkState;
 use tsukami_body::model::{JointId, LinkId, RobotModel};
 use tsukami_grasp::contact::Contact;
 use tsukami_grasp::grasp::Grasp;
-use tsukami_grasp::hold::{hold_test, Disturbances, HoldOptions, HoldVerdict};
+use tsukami_grasp::hold::{hold_test, Disturbances, HoldOptions, HoldVerdict, DECIDE_SAFETY};
 use tsukami_grasp::joint_torques::JointTorques;
 use tsukami_grasp::stiffness::GraspStiffness;
 use tsukami_msgs::planner::{DisturbanceSet, HoldRequest, JointSqueeze};
@@ -83,7 +83,7 @@ pub fn options(req: &HoldRequest) -> HoldOptions {
     HoldOptions {
         friction_reserve: req.friction_reserve,
         require_closure: req.disturbances == DisturbanceSet::Standard,
-        decide_only: false,
+        decide_up_to: None,
     }
 }
 
@@ -102,19 +102,31 @@ pub fn hold(
     contacts: &[HoldContact],
     req: &HoldRequest,
 ) -> Option<HoldVerdict> {
-    hold_with(p, contacts, req, false)
+    hold_with(p, contacts, req, None)
+}
+
+/// [`hold`] deciding up to scale `cap` (`tsukami_grasp::hold::HoldOptions::decide_up_to`):
+/// the same verdict, the margin clipped at `cap` (at least [`DECIDE_SAFETY`]),
+/// most disturbances without their program.
+pub fn hold_up_to(
+    p: &HoldProblem<'_>,
+    contacts: &[HoldContact],
+    req: &HoldRequest,
+    cap: f64,
+) -> Option<HoldVerdict> {
+    hold_with(p, contacts, req, Some(cap.max(DECIDE_SAFETY)))
 }
 
 fn hold_with(
     p: &HoldProblem<'_>,
     contacts: &[HoldContact],
     req: &HoldRequest,
-    decide_only: bool,
+    decide_up_to: Option<f64>,
 ) -> Option<HoldVerdict> {
     let (grasp, torques) = setup(p, contacts)?;
     let set = disturbances(p, &grasp, req);
     let opts = HoldOptions {
-        decide_only,
+        decide_up_to,
         ..options(req)
     };
     hold_test(&grasp, &torques, &set, &opts).ok()
@@ -193,14 +205,26 @@ fn gap_motion(torques: &JointTorques, contacts: &[HoldContact], gaps: &[f64]) ->
 
 /// The request's rule, decided: closure when the set is the standard one,
 /// every disturbance balanced; the verdict (its margins lower bounds:
-/// `tsukami_grasp::hold::HoldOptions::decide_only`, the same verdict as
+/// `tsukami_grasp::hold::HoldOptions::decide_up_to`, the same verdict as
 /// [`hold`]'s at a fraction of the cost) or why not. Searches call this.
 pub fn holds_under(
     p: &HoldProblem<'_>,
     contacts: &[HoldContact],
     req: &HoldRequest,
 ) -> Result<HoldVerdict, String> {
-    let v = rule(hold_with(p, contacts, req, true), req)?;
+    holds_up_to(p, contacts, req, DECIDE_SAFETY)
+}
+
+/// [`holds_under`] with the margin clipped at `cap` ([`hold_up_to`]): what a
+/// planner that ranks by a preferred margin needs, for less than
+/// [`holds_exactly`] costs.
+pub fn holds_up_to(
+    p: &HoldProblem<'_>,
+    contacts: &[HoldContact],
+    req: &HoldRequest,
+    cap: f64,
+) -> Result<HoldVerdict, String> {
+    let v = rule(hold_up_to(p, contacts, req, cap), req)?;
     within_stiffness(p, contacts, req)?;
     Ok(v)
 }

@@ -106,6 +106,9 @@ pub fn pose_errors(err: &PoseError, seed: u64) -> Vec<PoseErrorSample> {
         .collect()
 }
 
+/// Threads the re-check uses at most (the caller's and three more).
+const MAX_WORKERS: usize = 4;
+
 /// What the re-check needs besides the grasp.
 pub struct RobustProblem<'a> {
     /// The robot.
@@ -136,10 +139,28 @@ pub fn pose_robustness(
     seed: u64,
 ) -> PoseRobustness {
     let errors = pose_errors(&req.pose_error, seed);
-    let held = errors
-        .iter()
-        .filter(|e| holds_moved(p, q, contacts, e, req))
-        .count();
+    let count = |errs: &[PoseErrorSample]| {
+        errs.iter()
+            .filter(|e| holds_moved(p, q, contacts, e, req))
+            .count()
+    };
+    // The errors are independent: split over the machine's cores (a count,
+    // so the answer does not depend on how they are split).
+    let workers = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .clamp(1, MAX_WORKERS)
+        .min(errors.len().max(1));
+    let chunk = errors.len().div_ceil(workers).max(1);
+    let held: usize = std::thread::scope(|s| {
+        let mut parts = errors.chunks(chunk);
+        let first = parts.next().unwrap_or(&[]);
+        let others: Vec<_> = parts.map(|c| s.spawn(move || count(c))).collect();
+        let mine = count(first);
+        mine + others
+            .into_iter()
+            .map(|h| h.join().unwrap_or(0))
+            .sum::<usize>()
+    });
     PoseRobustness {
         samples: errors.len() as u32,
         held: held as u32,
