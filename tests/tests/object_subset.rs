@@ -27,7 +27,8 @@ const T: Duration = Duration::from_secs(120);
 
 /// (object, placement): one of each family, on every placement, upright and
 /// lying, chosen among the cases the benchmark plans; the last two plan only
-/// with an approach at an angle (`tilt` in the reply).
+/// with an approach at an angle (`tilt` in the reply; [`TILTED`] lists the
+/// cases whose reply is tilted).
 const SUBSET: [(&str, &str); 14] = [
     ("can_2", "table_0.78"),
     ("can_2", "table_0.72_lying"),
@@ -47,8 +48,12 @@ const SUBSET: [(&str, &str); 14] = [
 
 /// The cases of [`SUBSET`] no approach along the object box's axes holds —
 /// or, for the cone under the shelf's board, none whose approach, closing and
-/// lift are free (the grasp planner checks them, issue #23).
-const TILTED: [(&str, &str); 3] = [
+/// lift are free (the grasp planner checks them, issue #23); the can lying on
+/// the table, where the axis-aligned grasps hold under 5 of the 8 sampled pose
+/// errors at best and a tilted one under all (a weak fingertip grasp looks
+/// further, docs/force-closure.md, "Holding").
+const TILTED: [(&str, &str); 4] = [
+    ("can_2", "table_0.72_lying"),
     ("low_0", "counter_1.00_rotated"),
     ("low_3", "shelf_0.60"),
     ("cone_1", "shelf_0.60"),

@@ -97,26 +97,12 @@ fn a_finger_on_the_ring_in_the_pre_shape_is_opened_and_the_ring_is_grasped() {
     ]))
     .unwrap();
     p.set_robot(&robot()).unwrap();
-    let ring = objects::objects()
-        .into_iter()
-        .find(|o| o.name == "torus_1")
-        .unwrap();
-    let counter = objects::placements()
-        .into_iter()
-        // On the 0.78 m table: on the rotated counter every grasp that holds
-        // has the iiwa's elbow straight, so the palm cannot back out along
-        // the approach (`motion blocked`, issue #23).
-        .find(|p| p.name == "table_0.78")
-        .unwrap();
-    let path = root.join("ring.stl");
-    ring.mesh.write_stl(&path).unwrap();
-    let object: SetObject = serde_json::from_value(objects::set_object(
-        &ring,
-        &counter,
-        &path.display().to_string(),
-    ))
-    .unwrap();
-    let env: SetEnv = serde_json::from_value(objects::set_env(&counter)).unwrap();
+    // On the 0.78 m table: on the rotated counter every grasp that holds has
+    // the iiwa's elbow straight, so the palm cannot back out along the
+    // approach (`motion blocked`, issue #23).
+    let (object, env) = objects::case_requests("torus_1", "table_0.78", &root);
+    let object: SetObject = serde_json::from_value(object).unwrap();
+    let env: SetEnv = serde_json::from_value(env).unwrap();
     // What this test is about is the pre-shape opening; with the standard
     // disturbance set no closed hand of the 14,000 samples holds this fat ring
     // (issue #22's figures), so the request asks for the weight test.

@@ -26,6 +26,8 @@ fn models() -> PathBuf {
 }
 
 struct Case {
+    /// The folder of the mesh file (removed at the end).
+    dir: PathBuf,
     planner: Planner,
     robot: SetRobot,
     object: SetObject,
@@ -43,23 +45,13 @@ fn box_on_table() -> Case {
     .unwrap();
     let robot: SetRobot = serde_json::from_value(json!({"robot": "tsukami_humanoid"})).unwrap();
     planner.set_robot(&robot).unwrap();
-    let o = objects::objects()
-        .into_iter()
-        .find(|o| o.name == "box_4")
-        .unwrap();
-    let table = objects::placements()
-        .into_iter()
-        .find(|p| p.name == "table_0.78")
-        .unwrap();
-    let path = root.join("box_4.stl");
-    o.mesh.write_stl(&path).unwrap();
-    let object: SetObject =
-        serde_json::from_value(objects::set_object(&o, &table, &path.display().to_string()))
-            .unwrap();
-    let env: SetEnv = serde_json::from_value(objects::set_env(&table)).unwrap();
+    let (object, env) = objects::case_requests("box_4", "table_0.78", &root);
+    let object: SetObject = serde_json::from_value(object).unwrap();
+    let env: SetEnv = serde_json::from_value(env).unwrap();
     planner.set_object(&object).unwrap();
     planner.set_env(&env).unwrap();
     Case {
+        dir: root,
         planner,
         robot,
         object,
@@ -104,6 +96,7 @@ fn a_weak_fingertip_grasp_is_traded_for_a_better_one_of_a_later_tier() {
     // The same seed, the same reply.
     let again = plan(&c, &opts);
     assert_eq!(again.joint_positions, r.joint_positions);
+    let _ = std::fs::remove_dir_all(&c.dir);
 }
 
 /// An envelope set aside is returned when its stage is spent, weak or not:

@@ -413,6 +413,20 @@ pub fn set_object(o: &BenchObject, p: &Placement, path: &str) -> Value {
     req
 }
 
+/// The requests of one benchmark case: object `object` (by name) at placement
+/// `placement` (by name), its mesh written as `<object>.stl` under `dir`; the
+/// `set_object` and `set_env` requests. Panics on an unknown name (tests only).
+pub fn case_requests(object: &str, placement: &str, dir: &std::path::Path) -> (Value, Value) {
+    let o = objects().into_iter().find(|o| o.name == object).unwrap();
+    let p = placements()
+        .into_iter()
+        .find(|p| p.name == placement)
+        .unwrap();
+    let path = dir.join(format!("{object}.stl"));
+    o.mesh.write_stl(&path).unwrap();
+    (set_object(&o, &p, &path.display().to_string()), set_env(&p))
+}
+
 /// The `set_env` request of a placement.
 pub fn set_env(p: &Placement) -> Value {
     json!({"obstacles": p.obstacles, "replace": true})
