@@ -807,7 +807,8 @@ pub struct JointSqueeze {
     /// Servo stiffness (N·m/rad) the target assumes: the joint's effort over
     /// the hand's `servo_saturation`.
     pub stiffness: f64,
-    /// Target of a position-controlled hand: `position` + the motion that closes the contacts' gaps + `torque / stiffness`,
+    /// Target of a position-controlled hand: `position` + the motion that closes the
+    /// contacts' gaps and compresses their pads under the squeeze + `torque / stiffness`,
     /// clamped to the joint's limits (what a position-controlled hand commands from
     /// the end of `close` through the lift: the motion's points' `command`).
     pub target: f64,

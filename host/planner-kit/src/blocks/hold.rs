@@ -136,9 +136,12 @@ fn hold_with(
 /// (`tsukami_grasp::hold::squeeze` with the request's share) and, with the
 /// stiffness `effort / servo_saturation`, its target, within its limits. The
 /// target also closes each contact's remaining gap (`gaps[i]`, m: a finger
-/// stops within the contact distance, not on the surface): the least-norm
-/// joint motion that moves every contact point by its gap along its normal,
-/// so the whole servo error presses.
+/// stops within the contact distance, not on the surface) and compresses its
+/// pad by the squeeze's normal force over [`PAD_STIFFNESS`]: the least-norm
+/// joint motion that moves every contact point by gap plus compression along
+/// its normal, so the whole servo error presses. Without the compression a
+/// stiff servo (the Allegro's 15 N·m over 0.2 rad) would be commanded a few
+/// tenths of a millimetre past the surface, which the pad alone takes up.
 pub fn squeeze(
     p: &HoldProblem<'_>,
     contacts: &[HoldContact],
@@ -150,7 +153,15 @@ pub fn squeeze(
     let (grasp, torques) = setup(p, contacts)?;
     let s =
         tsukami_grasp::hold::squeeze(&grasp, &torques, req.squeeze_share, &options(req)).ok()?;
-    let close = gap_motion(&torques, contacts, gaps);
+    let travel: Vec<f64> = contacts
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let press = s.forces.get(i).map_or(0.0, |f| f.dot(&c.2).max(0.0));
+            gaps.get(i).copied().unwrap_or(0.0).max(0.0) + press / PAD_STIFFNESS
+        })
+        .collect();
+    let close = gap_motion(&torques, contacts, &travel);
     let out = p
         .joints
         .iter()
@@ -177,8 +188,8 @@ pub fn squeeze(
 }
 
 /// The least-norm joint motion `δq` with `nᵢᵀ Jᵢ δq = gapᵢ` for every contact
-/// that loads a joint (rows of contacts the structure carries are dropped);
-/// zeros when the rows are degenerate.
+/// that loads a joint (rows of contacts the structure carries are dropped), in
+/// the least-squares sense when the rows are dependent.
 fn gap_motion(torques: &JointTorques, contacts: &[HoldContact], gaps: &[f64]) -> Vec<f64> {
     let m = torques.joints();
     let rows: Vec<(nalgebra::RowDVector<f64>, f64)> = contacts
@@ -196,10 +207,11 @@ fn gap_motion(torques: &JointTorques, contacts: &[HoldContact], gaps: &[f64]) ->
     }
     let a = nalgebra::DMatrix::from_rows(&rows.iter().map(|r| r.0.clone()).collect::<Vec<_>>());
     let d = nalgebra::DVector::from_iterator(rows.len(), rows.iter().map(|r| r.1));
-    let aat = &a * a.transpose();
-    match aat.try_inverse() {
-        Some(inv) => (a.transpose() * inv * d).iter().copied().collect(),
-        None => vec![0.0; m],
+    // Least-norm least squares: two contacts on one link, or more contacts
+    // than joints, make the rows dependent; their mean travel is closed.
+    match a.svd(true, true).solve(&d, 1e-12) {
+        Ok(dq) => dq.iter().copied().collect(),
+        Err(_) => vec![0.0; m],
     }
 }
 
@@ -384,4 +396,75 @@ pub fn passive_response(
         }
     }
     Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two prismatic fingers closing along x on a 6 cm cube at the origin,
+    /// each touching it at two points, `gap` short of the surface.
+    fn gripper() -> RobotModel {
+        let finger = |name: &str, x: f64, axis: f64| {
+            format!(
+                r#"<link name="{name}"/>
+                <joint name="{name}_slide" type="prismatic"><parent link="base"/><child link="{name}"/>
+                  <origin xyz="{x} 0 0"/><axis xyz="{axis} 0 0"/>
+                  <limit lower="0" upper="0.05" effort="10" velocity="1"/></joint>"#
+            )
+        };
+        let urdf = format!(
+            r#"<robot name="g"><link name="base"/>{}{}</robot>"#,
+            finger("left", -0.05, 1.0),
+            finger("right", 0.05, -1.0)
+        );
+        RobotModel::from_urdf_str(&urdf, std::path::Path::new(".")).unwrap()
+    }
+
+    #[test]
+    fn the_target_closes_the_gap_and_compresses_the_pads_before_the_servo_presses() {
+        let model = gripper();
+        let q = [0.02, 0.02];
+        let mut fk = FkState::new(&model);
+        model.forward_kinematics(&q, &mut fk);
+        let joints = [
+            model.joint_id("left_slide").unwrap(),
+            model.joint_id("right_slide").unwrap(),
+        ];
+        let (left, right) = (
+            model.link_id("left").unwrap(),
+            model.link_id("right").unwrap(),
+        );
+        let contacts: Vec<HoldContact> = [(left, -0.03, 1.0), (right, 0.03, -1.0)]
+            .iter()
+            .flat_map(|&(l, x, n)| {
+                [-0.01, 0.01].map(|z| (l, Point3::new(x, 0.0, z), Vector3::new(n, 0.0, 0.0)))
+            })
+            .collect();
+        let p = HoldProblem {
+            model: &model,
+            fk: &fk,
+            joints: &joints,
+            cap: 20.0,
+            mass: 0.1,
+            mu: 0.5,
+            com: Point3::origin(),
+            length: 0.03,
+            servo_saturation: 0.01,
+        };
+        let gap = 0.0005;
+        let s = squeeze(&p, &contacts, &[gap; 4], &q, 0.01, &HoldRequest::default()).unwrap();
+        for js in &s {
+            // Each finger pushes with `torque` (N) shared by its two contacts,
+            // both normal: each pad compresses by torque / 2 / PAD_STIFFNESS.
+            assert!(js.torque > 1.0, "{js:?}");
+            assert_eq!(js.stiffness, 10.0 / 0.01);
+            let expected =
+                js.position + gap + js.torque / 2.0 / PAD_STIFFNESS + js.torque / js.stiffness;
+            assert!(
+                (js.target - expected).abs() < 1e-6,
+                "{js:?}: expected {expected}"
+            );
+        }
+    }
 }
